@@ -1,0 +1,58 @@
+// Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
+#pragma once
+
+#include "levelset.h"
+#include <cstdint>
+#include <vector>
+
+namespace contact
+{
+
+/// @brief Minimum level set phi_min = min(phi_i, phi_j) at the nodes (eq 21).
+/// @throws std::invalid_argument if the grids differ
+LevelSet min_levelset(const LevelSet& phi_i, const LevelSet& phi_j);
+
+/// @brief Intermediate level set phi_int = (phi_i - phi_j) / 2 at the nodes (eq 23).
+///
+/// Its zero contour is equidistant from both boundaries; grad phi_int points
+/// from body i towards body j.
+/// @throws std::invalid_argument if the grids differ
+LevelSet intermediate_levelset(const LevelSet& phi_i, const LevelSet& phi_j);
+
+/// @brief Closing level set psi = reinitialize(phi_min - eps) + eps (eq 22).
+///
+/// psi < 0 on the union of the bodies and on the "liquid bridges" narrower than
+/// about 2 eps between them.
+LevelSet closing_levelset(const LevelSet& phi_i, const LevelSet& phi_j, double eps);
+
+/// @brief Node flags of the contact region (eq 22) extended to overlaps:
+/// (phi_i > 0 and phi_j > 0 and psi < 0) or (phi_i < 0 and phi_j < 0).
+std::vector<std::int8_t> contact_region(const LevelSet& phi_i, const LevelSet& phi_j, double eps);
+
+/// @brief Candidate contact surface Gamma_c (eq 24) with its quadrature.
+struct ContactSurface
+{
+  std::vector<double> segments;        ///< (ns, 2, 2) segment end points
+  std::vector<std::int32_t> cells;     ///< (ns,) grid cell of each segment
+  std::vector<double> points;          ///< (nq, 2) quadrature points
+  std::vector<double> weights;         ///< (nq,) quadrature weights (length measure)
+  std::vector<double> normals;         ///< (nq, 2) unit grad phi_int / |grad phi_int| (i -> j)
+  std::vector<double> tangents;        ///< (nq, 2) t = (-n_y, n_x)
+  std::vector<std::int32_t> segment;   ///< (nq,) segment of each quadrature point
+};
+
+/// @brief Zero contour of phi_int restricted to the contact region (eqs 22-24).
+///
+/// In each grid cell crossed by phi_int = 0 the contour is a straight segment
+/// between its edge crossings (found on the C1 interpolant by bracketed root
+/// finding; saddle cells resolved by the value at the cell centre). On Gamma_int
+/// phi_i = phi_j, so the region test reduces to psi < 0 and a segment is clipped
+/// where psi changes sign; overlapping (penetrated) parts are always kept.
+/// Each segment carries `num_gauss` Gauss-Legendre points.
+/// @param[in] phi_i, phi_j Level sets of the two bodies on the same grid
+/// @param[in] eps Shift parameter of eq 22 (> 0), a length
+/// @param[in] num_gauss Gauss points per segment (1..5)
+ContactSurface contact_surface(const LevelSet& phi_i, const LevelSet& phi_j, double eps,
+                               int num_gauss = 2);
+
+} // namespace contact
