@@ -1,2 +1,230 @@
 // Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
-// (being written)
+#include "contact_surface.h"
+#include "reinit.h"
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+using namespace contact;
+
+namespace {
+void check_same_grid(const LevelSet& a, const LevelSet& b, const char* fn) {
+  for (int d = 0; d < 2; ++d)
+    if (a.grid().axis(d) != b.grid().axis(d))
+      throw std::invalid_argument(std::string(fn) + ": the two level sets must share one grid");
+}
+
+LevelSet combine(const LevelSet& a, const LevelSet& b, double (*op)(double, double)) {
+  std::vector<double> v(a.values().size());
+  for (std::size_t k = 0; k < v.size(); ++k)
+    v[k] = op(a.values()[k], b.values()[k]);
+  return LevelSet(a.grid(), std::move(v));
+}
+
+/// Root of f on [0, 1] with f(0) f(1) <= 0 (Illinois variant of regula falsi:
+/// superlinear and bracketed, so it cannot leave the edge).
+template <typename F> double bracketed_root(F&& f, double f0, double f1) {
+  if (f0 == 0)
+    return 0.0;
+  if (f1 == 0)
+    return 1.0;
+  double t0 = 0, t1 = 1;
+  int side = 0;
+  for (int it = 0; it < 100 and t1 - t0 > 1e-15; ++it) {
+    const double t = (t0 * f1 - t1 * f0) / (f1 - f0);
+    const double ft = f(t);
+    if (ft == 0)
+      return t;
+    if ((ft < 0) == (f0 < 0)) {
+      t0 = t, f0 = ft;
+      if (side == -1)
+        f1 *= 0.5;
+      side = -1;
+    } else {
+      t1 = t, f1 = ft;
+      if (side == 1)
+        f0 *= 0.5;
+      side = 1;
+    }
+  }
+  return (t0 * f1 - t1 * f0) / (f1 - f0);
+}
+
+// Gauss-Legendre points and weights on [0, 1]
+void gauss_legendre(int n, std::vector<double>& x, std::vector<double>& w) {
+  static const double p[5][5] = {
+      {0.0},
+      {-0.5773502691896257, 0.5773502691896257},
+      {-0.7745966692414834, 0.0, 0.7745966692414834},
+      {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526},
+      {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640}};
+  static const double q[5][5] = {
+      {2.0},
+      {1.0, 1.0},
+      {0.5555555555555556, 0.8888888888888888, 0.5555555555555556},
+      {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538},
+      {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
+       0.2369268850561891}};
+  x.resize(n);
+  w.resize(n);
+  for (int k = 0; k < n; ++k) {
+    x[k] = 0.5 * (p[n - 1][k] + 1.0);
+    w[k] = 0.5 * q[n - 1][k];
+  }
+}
+} // namespace
+
+LevelSet contact::min_levelset(const LevelSet& phi_i, const LevelSet& phi_j) {
+  check_same_grid(phi_i, phi_j, "min_levelset");
+  return combine(phi_i, phi_j, [](double a, double b) { return std::min(a, b); });
+}
+
+LevelSet contact::intermediate_levelset(const LevelSet& phi_i, const LevelSet& phi_j) {
+  check_same_grid(phi_i, phi_j, "intermediate_levelset");
+  return combine(phi_i, phi_j, [](double a, double b) { return 0.5 * (a - b); });
+}
+
+LevelSet contact::closing_levelset(const LevelSet& phi_i, const LevelSet& phi_j, double eps) {
+  if (!(eps > 0) or !std::isfinite(eps))
+    throw std::invalid_argument("contact region: eps must be a finite length > 0");
+  check_same_grid(phi_i, phi_j, "closing_levelset");
+  // Dilate the union by eps, make it a distance again, erode by eps (eq 22)
+  std::vector<double> v(phi_i.values().size());
+  for (std::size_t k = 0; k < v.size(); ++k)
+    v[k] = std::min(phi_i.values()[k], phi_j.values()[k]) - eps;
+  LevelSet psi = reinitialize(LevelSet(phi_i.grid(), std::move(v)));
+  std::vector<double> w(psi.values().begin(), psi.values().end());
+  for (double& x : w)
+    x += eps;
+  return LevelSet(phi_i.grid(), std::move(w));
+}
+
+std::vector<std::int8_t> contact::contact_region(const LevelSet& phi_i, const LevelSet& phi_j,
+                                                 double eps) {
+  const LevelSet psi = closing_levelset(phi_i, phi_j, eps);
+  const auto a = phi_i.values(), b = phi_j.values(), c = psi.values();
+  std::vector<std::int8_t> flags(a.size());
+  for (std::size_t k = 0; k < a.size(); ++k)
+    flags[k] = (a[k] > 0 and b[k] > 0 and c[k] < 0) or (a[k] < 0 and b[k] < 0);
+  return flags;
+}
+
+ContactSurface contact::contact_surface(const LevelSet& phi_i, const LevelSet& phi_j, double eps,
+                                        int num_gauss) {
+  if (num_gauss < 1 or num_gauss > 5)
+    throw std::invalid_argument("contact_surface: num_gauss must be in 1..5, got " +
+                                std::to_string(num_gauss));
+  const LevelSet phi = intermediate_levelset(phi_i, phi_j);
+  const LevelSet psi = closing_levelset(phi_i, phi_j, eps);
+  const StructuredGrid& grid = phi.grid();
+  const auto& ax = grid.axis(0);
+  const auto& ay = grid.axis(1);
+  const auto v = phi.values();
+  const double h = grid.min_spacing();
+
+  // Region indicator on Gamma_int: psi < 0 (bridge) or phi_i = phi_j < 0 (overlap)
+  auto region = [&](std::array<double, 2> x) {
+    std::span<const double, 2> xs(x.data(), 2);
+    return std::min(psi.eval(xs), 0.5 * (phi_i.eval(xs) + phi_j.eval(xs)));
+  };
+  auto phi_at = [&](std::array<double, 2> x) {
+    return phi.eval(std::span<const double, 2>(x.data(), 2));
+  };
+
+  // Zero of phi on the grid edge from node a to node b (always from the lower
+  // index, so both cells sharing an edge find bitwise the same point)
+  auto edge_root = [&](std::array<double, 2> a, std::array<double, 2> b, double fa, double fb) {
+    auto f = [&](double t) { return phi_at({a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])}); };
+    const double t = bracketed_root(f, fa, fb);
+    return std::array<double, 2>{a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])};
+  };
+
+  ContactSurface s;
+  std::vector<double> gx, gw;
+  gauss_legendre(num_gauss, gx, gw);
+
+  for (std::size_t j = 0; j + 1 < ay.size(); ++j)
+    for (std::size_t i = 0; i + 1 < ax.size(); ++i) {
+      // Corners in tensor order (0,0), (1,0), (0,1), (1,1); zero counts as positive
+      const double f[4] = {v[grid.node(i, j)], v[grid.node(i + 1, j)], v[grid.node(i, j + 1)],
+                           v[grid.node(i + 1, j + 1)]};
+      const bool neg[4] = {f[0] < 0, f[1] < 0, f[2] < 0, f[3] < 0};
+      if (neg[0] == neg[1] and neg[0] == neg[2] and neg[0] == neg[3])
+        continue;
+      const std::array<double, 2> X[4] = {
+          {ax[i], ay[j]}, {ax[i + 1], ay[j]}, {ax[i], ay[j + 1]}, {ax[i + 1], ay[j + 1]}};
+      // Edges: bottom (0,1), right (1,3), top (2,3), left (0,2)
+      static const int E[4][2] = {{0, 1}, {1, 3}, {2, 3}, {0, 2}};
+      std::array<double, 2> cross[4];
+      bool has[4];
+      for (int e = 0; e < 4; ++e) {
+        const int a = E[e][0], b = E[e][1];
+        has[e] = neg[a] != neg[b];
+        if (has[e])
+          cross[e] = edge_root(X[a], X[b], f[a], f[b]);
+      }
+      // Pair the crossings into segments
+      std::vector<std::array<int, 2>> pairs;
+      if (has[0] and has[1] and has[2] and has[3]) {
+        // Saddle: decide with the interpolant at the cell centre
+        const double fc = phi_at({0.5 * (ax[i] + ax[i + 1]), 0.5 * (ay[j] + ay[j + 1])});
+        if ((fc < 0) == neg[0])
+          pairs = {{0, 1}, {3, 2}}; // diagonal 0-3 connected: cut off corners 1 and 2
+        else
+          pairs = {{3, 0}, {1, 2}}; // cut off corners 0 and 3
+      } else {
+        int e0 = -1, e1 = -1;
+        for (int e = 0; e < 4; ++e)
+          if (has[e])
+            (e0 < 0 ? e0 : e1) = e;
+        pairs = {{e0, e1}};
+      }
+
+      for (auto [ea, eb] : pairs) {
+        std::array<double, 2> p = cross[ea], q = cross[eb];
+        // Clip to the contact region (eqs 22, 24)
+        const double rp = region(p), rq = region(q);
+        if (rp >= 0 and rq >= 0)
+          continue;
+        if ((rp < 0) != (rq < 0)) {
+          auto g = [&](double t) {
+            return region({p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])});
+          };
+          const double t = bracketed_root(g, rp, rq);
+          const std::array<double, 2> m{p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])};
+          (rp < 0 ? q : p) = m;
+        }
+        const double len = std::hypot(q[0] - p[0], q[1] - p[1]);
+        if (len <= 1e-12 * h)
+          continue;
+        const std::int32_t seg = std::int32_t(s.cells.size());
+        s.segments.insert(s.segments.end(), {p[0], p[1], q[0], q[1]});
+        s.cells.push_back(std::int32_t(grid.cell(i, j)));
+        // Unit normal of the segment, for the rare point where grad phi_int vanishes
+        double sn[2] = {-(q[1] - p[1]) / len, (q[0] - p[0]) / len};
+        for (int k = 0; k < num_gauss; ++k) {
+          const double x[2] = {p[0] + gx[k] * (q[0] - p[0]), p[1] + gx[k] * (q[1] - p[1])};
+          double g[2];
+          phi.eval(std::span<const double, 2>(x, 2), std::span<double, 2>(g, 2));
+          double gn = std::hypot(g[0], g[1]);
+          double n[2];
+          if (gn > 1e-12)
+            n[0] = g[0] / gn, n[1] = g[1] / gn;
+          else {
+            // Orient the segment normal towards increasing phi_int (body i -> body j)
+            const double xp[2] = {x[0] + 1e-3 * h * sn[0], x[1] + 1e-3 * h * sn[1]};
+            const double xm[2] = {x[0] - 1e-3 * h * sn[0], x[1] - 1e-3 * h * sn[1]};
+            const double sgn = phi_at({xp[0], xp[1]}) >= phi_at({xm[0], xm[1]}) ? 1.0 : -1.0;
+            n[0] = sgn * sn[0], n[1] = sgn * sn[1];
+          }
+          s.points.insert(s.points.end(), {x[0], x[1]});
+          s.weights.push_back(gw[k] * len);
+          s.normals.insert(s.normals.end(), {n[0], n[1]});
+          s.tangents.insert(s.tangents.end(), {-n[1], n[0]});
+          s.segment.push_back(seg);
+        }
+      }
+    }
+  return s;
+}

@@ -5,8 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace contact
-{
+namespace contact {
 
 /// @brief Minimum level set phi_min = min(phi_i, phi_j) at the nodes (eq 21).
 /// @throws std::invalid_argument if the grids differ
@@ -30,15 +29,14 @@ LevelSet closing_levelset(const LevelSet& phi_i, const LevelSet& phi_j, double e
 std::vector<std::int8_t> contact_region(const LevelSet& phi_i, const LevelSet& phi_j, double eps);
 
 /// @brief Candidate contact surface Gamma_c (eq 24) with its quadrature.
-struct ContactSurface
-{
-  std::vector<double> segments;        ///< (ns, 2, 2) segment end points
-  std::vector<std::int32_t> cells;     ///< (ns,) grid cell of each segment
-  std::vector<double> points;          ///< (nq, 2) quadrature points
-  std::vector<double> weights;         ///< (nq,) quadrature weights (length measure)
-  std::vector<double> normals;         ///< (nq, 2) unit grad phi_int / |grad phi_int| (i -> j)
-  std::vector<double> tangents;        ///< (nq, 2) t = (-n_y, n_x)
-  std::vector<std::int32_t> segment;   ///< (nq,) segment of each quadrature point
+struct ContactSurface {
+  std::vector<double> segments;      ///< (ns, 2, 2) segment end points
+  std::vector<std::int32_t> cells;   ///< (ns,) grid cell of each segment
+  std::vector<double> points;        ///< (nq, 2) quadrature points
+  std::vector<double> weights;       ///< (nq,) quadrature weights (length measure)
+  std::vector<double> normals;       ///< (nq, 2) unit grad phi_int / |grad phi_int| (i -> j)
+  std::vector<double> tangents;      ///< (nq, 2) t = (-n_y, n_x)
+  std::vector<std::int32_t> segment; ///< (nq,) segment of each quadrature point
 };
 
 /// @brief Zero contour of phi_int restricted to the contact region (eqs 22-24).

@@ -3,8 +3,7 @@
 
 #include <span>
 
-namespace contact
-{
+namespace contact {
 
 /// @brief Gap functions at contact points (eqs 26-31), 2D.
 ///

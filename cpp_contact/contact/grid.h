@@ -8,8 +8,7 @@
 #include <span>
 #include <vector>
 
-namespace contact
-{
+namespace contact {
 
 /// @brief Structured tensor-product grid in 2D (uniform or graded spacing).
 ///
@@ -17,8 +16,7 @@ namespace contact
 /// (nx - 1) cells per row. The axes are stored explicitly so a graded grid
 /// costs nothing extra; a uniform axis is detected and located in O(1).
 /// The dimension is a compile-time constant so a 3D grid is an extension.
-class StructuredGrid
-{
+class StructuredGrid {
 public:
   static constexpr int gdim = 2;
 
@@ -51,8 +49,7 @@ public:
   std::size_t cell(std::size_t i, std::size_t j) const { return i + (_axes[0].size() - 1) * j; }
 
   /// @brief Coordinates of node (i, j).
-  std::array<double, 2> node_coordinates(std::size_t i, std::size_t j) const
-  {
+  std::array<double, 2> node_coordinates(std::size_t i, std::size_t j) const {
     return {_axes[0][i], _axes[1][j]};
   }
 

@@ -6,8 +6,7 @@
 #include <span>
 #include <vector>
 
-namespace contact
-{
+namespace contact {
 
 /// @brief Level set phi on a structured grid (eq 17: phi < 0 inside, > 0 outside).
 ///
@@ -16,8 +15,7 @@ namespace contact
 /// (possibly graded) grid. For smooth phi the value error is O(h^3) and the
 /// gradient error O(h^2); the gradient is continuous across cells, which the
 /// closest-point iteration (eq 25) and the contact normal (eq 18) rely on.
-class LevelSet
-{
+class LevelSet {
 public:
   /// @brief Level set from node values (x-fastest numbering of the grid).
   /// @throws std::invalid_argument if the size is wrong or a value is not finite
@@ -35,6 +33,10 @@ public:
   /// @return phi(x)
   double eval(std::span<const double, 2> x, std::span<double, 2> grad) const;
 
+  /// @brief Value, gradient and Hessian (xx, xy, yy) of the interpolant at x (in the grid).
+  double eval(std::span<const double, 2> x, std::span<double, 2> grad,
+              std::span<double, 3> hess) const;
+
   /// @brief Value of the interpolant at x (in the grid), without the gradient.
   double eval(std::span<const double, 2> x) const;
 
@@ -48,7 +50,8 @@ public:
 
 private:
   // Hermite data of cell (i, j) at local coordinates (s, t) in [0, 1]^2
-  double eval_cell(std::size_t i, std::size_t j, double s, double t, double* grad) const;
+  double eval_cell(std::size_t i, std::size_t j, double s, double t, double* grad,
+                   double* hess = nullptr) const;
 
   StructuredGrid _grid;
   std::vector<double> _values;
@@ -57,9 +60,7 @@ private:
 };
 
 /// @brief Node values of the grid-sampled function f (x-fastest).
-template <typename F>
-std::vector<double> sample_on_grid(const StructuredGrid& grid, F&& f)
-{
+template <typename F> std::vector<double> sample_on_grid(const StructuredGrid& grid, F&& f) {
   std::vector<double> v(grid.num_nodes());
   const auto& x = grid.axis(0);
   const auto& y = grid.axis(1);

@@ -6,12 +6,10 @@
 #include <span>
 #include <vector>
 
-namespace contact
-{
+namespace contact {
 
 /// @brief Outcome of the closest-point iteration at one point.
-enum class ProjectionStatus : std::int8_t
-{
+enum class ProjectionStatus : std::int8_t {
   converged = 0,          ///< step and residual below tolerance
   max_iterations = 1,     ///< iteration cap reached
   vanishing_gradient = 2, ///< |grad phi| too small (e.g. medial axis): direction undefined
@@ -19,19 +17,18 @@ enum class ProjectionStatus : std::int8_t
 };
 
 /// @brief Controls of the closest-point iteration.
-struct ProjectionOptions
-{
-  double rtol = 1e-10;    ///< tolerance on the step and on |phi|/|grad phi|, relative to min grid spacing
+struct ProjectionOptions {
+  double rtol =
+      1e-10; ///< tolerance on the step and on |phi|/|grad phi|, relative to min grid spacing
   int max_iterations = 50; ///< iteration cap
   double grad_tol = 1e-8;  ///< |grad phi| below this (relative to 1, phi being ~ a distance) fails
 };
 
 /// @brief Result of closest_point_projection for n points.
-struct ProjectionResult
-{
-  std::vector<double> points;               ///< (n, 2) projected points P(x0)
-  std::vector<ProjectionStatus> status;     ///< per point
-  std::vector<std::int32_t> iterations;     ///< iterations used per point
+struct ProjectionResult {
+  std::vector<double> points;           ///< (n, 2) projected points P(x0)
+  std::vector<ProjectionStatus> status; ///< per point
+  std::vector<std::int32_t> iterations; ///< iterations used per point
 };
 
 /// @brief Closest-point projection onto the zero contour of phi (eq 25, Rycroft & Gibou).

@@ -5,8 +5,7 @@
 #include <span>
 #include <vector>
 
-namespace contact
-{
+namespace contact {
 
 /// @brief Reinitialise phi to a signed distance while keeping its zero contour in place.
 ///

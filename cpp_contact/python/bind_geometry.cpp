@@ -1,3 +1,223 @@
-// (being written)
-#include <pybind11/pybind11.h>
-void bind_geometry(pybind11::module_&) {}
+// Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
+// Bindings of the level-set geometry: grids, level sets, shapes, projection (eq 25),
+// reinitialisation and the intermediate contact surface (eqs 21-24).
+#include "array.h"
+#include <contact/contact_surface.h>
+#include <contact/grid.h>
+#include <contact/levelset.h>
+#include <contact/projection.h>
+#include <contact/reinit.h>
+#include <contact/shapes.h>
+#include <pybind11/stl.h>
+
+namespace py = pybind11;
+using namespace contact;
+using contact::python::as_span;
+using contact::python::carray;
+using contact::python::to_numpy;
+
+void bind_geometry(py::module_& m) {
+  py::class_<StructuredGrid>(m, "StructuredGrid",
+                             "Tensor-product 2D grid, uniform or graded; nodes x-fastest")
+      .def(py::init([](const carray& x, const carray& y) {
+             auto sx = as_span(x, "x"), sy = as_span(y, "y");
+             return StructuredGrid({sx.begin(), sx.end()}, {sy.begin(), sy.end()});
+           }),
+           py::arg("x"), py::arg("y"), "Grid from strictly increasing node coordinates per axis")
+      .def_static("uniform", &StructuredGrid::uniform, py::arg("lo"), py::arg("hi"), py::arg("n"),
+                  "Uniform grid of [lo, hi] with n[d] cells along axis d")
+      .def_property_readonly("x",
+                             [](const StructuredGrid& g) {
+                               return py::array_t<double>(py::ssize_t(g.axis(0).size()),
+                                                          g.axis(0).data());
+                             })
+      .def_property_readonly("y",
+                             [](const StructuredGrid& g) {
+                               return py::array_t<double>(py::ssize_t(g.axis(1).size()),
+                                                          g.axis(1).data());
+                             })
+      .def_property_readonly(
+          "shape",
+          [](const StructuredGrid& g) { return py::make_tuple(g.num_nodes(1), g.num_nodes(0)); },
+          "(ny, nx): shape of node arrays")
+      .def_property_readonly("num_nodes",
+                             py::overload_cast<>(&StructuredGrid::num_nodes, py::const_))
+      .def_property_readonly("num_cells", &StructuredGrid::num_cells)
+      .def_property_readonly("min_spacing", &StructuredGrid::min_spacing)
+      .def_property_readonly("max_spacing", &StructuredGrid::max_spacing)
+      .def(
+          "nodes",
+          [](const StructuredGrid& g) {
+            std::vector<double> p(2 * g.num_nodes());
+            for (std::size_t j = 0; j < g.num_nodes(1); ++j)
+              for (std::size_t i = 0; i < g.num_nodes(0); ++i) {
+                p[2 * g.node(i, j)] = g.axis(0)[i];
+                p[2 * g.node(i, j) + 1] = g.axis(1)[j];
+              }
+            return to_numpy(std::move(p), {py::ssize_t(g.num_nodes()), 2});
+          },
+          "Node coordinates, shape (num_nodes, 2), x-fastest")
+      .def(
+          "locate",
+          [](const StructuredGrid& g, const carray& pts) {
+            auto x = as_span(pts, "points", 2);
+            std::vector<std::int64_t> c(x.size() / 2, -1);
+            for (std::size_t p = 0; p < c.size(); ++p)
+              if (auto ij = g.locate(std::span<const double, 2>(x.data() + 2 * p, 2)))
+                c[p] = std::int64_t(g.cell((*ij)[0], (*ij)[1]));
+            return to_numpy(std::move(c), {py::ssize_t(c.size())});
+          },
+          py::arg("points"), "Cell index of each point ((n, 2) -> (n,)), -1 outside the grid");
+
+  py::class_<LevelSet>(m, "LevelSet", "Level set on a grid (eq 17), C1 bicubic Hermite interpolant")
+      .def(py::init([](const StructuredGrid& g, const carray& v) {
+             auto s = as_span(v, "values");
+             return LevelSet(g, {s.begin(), s.end()});
+           }),
+           py::arg("grid"), py::arg("values"), "From node values, flat x-fastest or shape (ny, nx)")
+      .def_property_readonly("grid", &LevelSet::grid)
+      .def_property_readonly(
+          "values",
+          [](const LevelSet& l) {
+            return py::array_t<double>(
+                {py::ssize_t(l.grid().num_nodes(1)), py::ssize_t(l.grid().num_nodes(0))},
+                l.values().data());
+          },
+          "Node values as a (ny, nx) copy")
+      .def(
+          "evaluate",
+          [](const LevelSet& l, const carray& pts) {
+            auto x = as_span(pts, "points", 2);
+            std::vector<double> v(x.size() / 2), g(x.size());
+            l.evaluate(x, v, g);
+            const auto n = py::ssize_t(v.size());
+            return py::make_tuple(to_numpy(std::move(v), {n}), to_numpy(std::move(g), {n, 2}));
+          },
+          py::arg("points"), "(values (n,), gradients (n, 2)) of the interpolant at (n, 2) points");
+
+  py::class_<Shape, std::shared_ptr<Shape>>(m, "Shape", "Analytic body: phi < 0 inside")
+      .def(
+          "__call__",
+          [](const Shape& s, const carray& pts) {
+            auto x = as_span(pts, "points", 2);
+            std::vector<double> v(x.size() / 2);
+            s.evaluate(x, v);
+            return to_numpy(std::move(v), {py::ssize_t(v.size())});
+          },
+          py::arg("points"), "Level-set values at (n, 2) points");
+  py::class_<Circle, Shape, std::shared_ptr<Circle>>(m, "Circle")
+      .def(py::init<std::array<double, 2>, double>(), py::arg("center"), py::arg("radius"));
+  py::class_<Ellipse, Shape, std::shared_ptr<Ellipse>>(m, "Ellipse")
+      .def(py::init<std::array<double, 2>, double, double, double>(), py::arg("center"),
+           py::arg("a"), py::arg("b"), py::arg("angle") = 0.0)
+      .def(
+          "closest_point",
+          [](const Ellipse& e, const carray& pts) {
+            auto x = as_span(pts, "points", 2);
+            std::vector<double> q(x.size());
+            for (std::size_t p = 0; p < x.size() / 2; ++p) {
+              auto c = e.closest_point({x[2 * p], x[2 * p + 1]});
+              q[2 * p] = c[0], q[2 * p + 1] = c[1];
+            }
+            return to_numpy(std::move(q), {py::ssize_t(x.size() / 2), 2});
+          },
+          py::arg("points"), "Exact closest points on the ellipse");
+  py::class_<Box, Shape, std::shared_ptr<Box>>(m, "Box").def(
+      py::init<std::array<double, 2>, std::array<double, 2>>(), py::arg("lo"), py::arg("hi"));
+  py::class_<Polygon, Shape, std::shared_ptr<Polygon>>(m, "Polygon")
+      .def(py::init([](const carray& v) {
+             auto s = as_span(v, "vertices", 2);
+             return std::make_shared<Polygon>(std::vector<double>(s.begin(), s.end()));
+           }),
+           py::arg("vertices"));
+  py::class_<Union, Shape, std::shared_ptr<Union>>(m, "Union")
+      .def(py::init([](const std::vector<std::shared_ptr<Shape>>& parts) {
+             return std::make_shared<Union>(
+                 std::vector<std::shared_ptr<const Shape>>(parts.begin(), parts.end()));
+           }),
+           py::arg("shapes"));
+  py::class_<Intersection, Shape, std::shared_ptr<Intersection>>(m, "Intersection")
+      .def(py::init([](const std::vector<std::shared_ptr<Shape>>& parts) {
+             return std::make_shared<Intersection>(
+                 std::vector<std::shared_ptr<const Shape>>(parts.begin(), parts.end()));
+           }),
+           py::arg("shapes"));
+  py::class_<Complement, Shape, std::shared_ptr<Complement>>(m, "Complement")
+      .def(
+          py::init([](const std::shared_ptr<Shape>& s) { return std::make_shared<Complement>(s); }),
+          py::arg("shape"));
+
+  m.def("levelset_from_shape", &levelset_from_shape, py::arg("grid"), py::arg("shape"),
+        "Sample an analytic shape at the grid nodes");
+  m.def(
+      "levelset_from_polyline",
+      [](const StructuredGrid& g, const carray& v, int band) {
+        return levelset_from_polyline(g, as_span(v, "vertices", 2), band);
+      },
+      py::arg("grid"), py::arg("vertices"), py::arg("band") = 3,
+      "Signed distance to a closed polyline: exact in a band, fast sweeping beyond");
+  m.def("reinitialize", &reinitialize, py::arg("phi"), py::arg("max_sweeps") = 8,
+        "Signed distance with the same zero contour (projection near it, fast sweeping beyond)");
+
+  py::enum_<ProjectionStatus>(m, "ProjectionStatus")
+      .value("converged", ProjectionStatus::converged)
+      .value("max_iterations", ProjectionStatus::max_iterations)
+      .value("vanishing_gradient", ProjectionStatus::vanishing_gradient)
+      .value("left_grid", ProjectionStatus::left_grid);
+  m.def(
+      "closest_point_projection",
+      [](const LevelSet& phi, const carray& pts, double rtol, int max_iterations, double grad_tol) {
+        ProjectionResult r = closest_point_projection(
+            phi, as_span(pts, "points", 2), ProjectionOptions{rtol, max_iterations, grad_tol});
+        const auto n = py::ssize_t(r.iterations.size());
+        std::vector<std::int8_t> st(r.status.size());
+        for (std::size_t p = 0; p < st.size(); ++p)
+          st[p] = std::int8_t(r.status[p]);
+        py::array_t<bool> conv(n);
+        for (py::ssize_t p = 0; p < n; ++p)
+          conv.mutable_at(p) = r.status[p] == ProjectionStatus::converged;
+        py::dict d;
+        d["points"] = to_numpy(std::move(r.points), {n, 2});
+        d["status"] = to_numpy(std::move(st), {n});
+        d["iterations"] = to_numpy(std::move(r.iterations), {n});
+        d["converged"] = conv;
+        return d;
+      },
+      py::arg("phi"), py::arg("points"), py::arg("rtol") = 1e-10, py::arg("max_iterations") = 50,
+      py::arg("grad_tol") = 1e-8,
+      "Closest points on phi = 0 (eq 25) of (n, 2) points inside the grid. Returns a dict: "
+      "points (n, 2), status (int8, ProjectionStatus), iterations, converged (bool)");
+
+  m.def("min_levelset", &min_levelset, py::arg("phi_i"), py::arg("phi_j"), "phi_min (eq 21)");
+  m.def("intermediate_levelset", &intermediate_levelset, py::arg("phi_i"), py::arg("phi_j"),
+        "phi_int = (phi_i - phi_j)/2 (eq 23)");
+  m.def("closing_levelset", &closing_levelset, py::arg("phi_i"), py::arg("phi_j"), py::arg("eps"),
+        "reinitialize(phi_min - eps) + eps (eq 22)");
+  m.def(
+      "contact_region",
+      [](const LevelSet& a, const LevelSet& b, double eps) {
+        auto f = contact_region(a, b, eps);
+        return to_numpy(std::move(f),
+                        {py::ssize_t(a.grid().num_nodes(1)), py::ssize_t(a.grid().num_nodes(0))});
+      },
+      py::arg("phi_i"), py::arg("phi_j"), py::arg("eps"),
+      "Node flags (ny, nx) of the contact region (eq 22) including overlaps");
+  m.def(
+      "contact_surface",
+      [](const LevelSet& a, const LevelSet& b, double eps, int num_gauss) {
+        ContactSurface s = contact_surface(a, b, eps, num_gauss);
+        const auto ns = py::ssize_t(s.cells.size()), nq = py::ssize_t(s.weights.size());
+        py::dict d;
+        d["segments"] = to_numpy(std::move(s.segments), {ns, 2, 2});
+        d["cells"] = to_numpy(std::move(s.cells), {ns});
+        d["points"] = to_numpy(std::move(s.points), {nq, 2});
+        d["weights"] = to_numpy(std::move(s.weights), {nq});
+        d["normals"] = to_numpy(std::move(s.normals), {nq, 2});
+        d["tangents"] = to_numpy(std::move(s.tangents), {nq, 2});
+        d["segment"] = to_numpy(std::move(s.segment), {nq});
+        return d;
+      },
+      py::arg("phi_i"), py::arg("phi_j"), py::arg("eps"), py::arg("num_gauss") = 2,
+      "Gamma_c (eq 24): segments of phi_int = 0 in the contact region with Gauss points, weights, "
+      "normals (body i -> j) and tangents");
+}

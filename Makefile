@@ -1,0 +1,61 @@
+# Two commands on a fresh Debian 12 machine (see README.md):
+#   make demo   installs what is missing, builds, runs the main demo, prints where results are
+#   make test   installs what is missing, builds, runs ctest, pytest and pytest under mpirun -n 2
+# Only Debian's archive is used. The system interpreter is named explicitly: the
+# python3 first on PATH on these machines lacks Debian's packages.
+
+PYTHON  ?= /usr/bin/python3
+BUILD   ?= build
+OUT     ?= results
+JOBS    ?= 2
+APT_PACKAGES := cmake make g++ python3-dolfinx libdolfinx-dev python3-gmsh gmsh \
+	libeigen3-dev python3-mpi4py python3-meshio pybind11-dev python3-pytest \
+	python3-scipy python3-matplotlib libgtest-dev libbenchmark-dev python3-setuptools \
+	python3-venv openmpi-bin
+export OMPI_ALLOW_RUN_AS_ROOT := 1
+export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
+export OMPI_MCA_rmaps_base_oversubscribe := 1
+MPIRUN  ?= mpirun -n 2
+SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+
+.PHONY: deps build test test-cpp test-python test-mpi demo bench format clean
+
+deps:
+	@missing=$$(for p in $(APT_PACKAGES); do \
+	  dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+	  echo "Installing Debian packages:" $$missing; \
+	  $(SUDO) apt-get update -q && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -q --no-install-recommends $$missing; \
+	fi
+
+build: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=$(PYTHON)
+	cmake --build $(BUILD) -j $(JOBS)
+
+test: build
+	$(MAKE) --no-print-directory test-cpp test-python test-mpi
+
+test-cpp:
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
+
+test-python:
+	$(PYTHON) -m pytest -m "not mpi"
+
+test-mpi:
+	$(MPIRUN) $(PYTHON) -m pytest -m mpi -p no:cacheprovider
+
+demo: build
+	$(PYTHON) demos/contact_geometry.py --out $(OUT)/contact_geometry
+
+bench: build
+	$(BUILD)/cpp_contact/contact_bench --benchmark_out=benchmarks/results/geometry.json \
+	  --benchmark_out_format=json
+	$(PYTHON) benchmarks/plot_geometry.py benchmarks/results/geometry.json
+
+format:
+	clang-format -i cpp_contact/*/*.h cpp_contact/*/*.cpp
+	black -q -l 100 dolfinx_forms tests demos benchmarks meshes 2>/dev/null || true
+
+clean:
+	rm -rf $(BUILD) dolfinx_forms/_cpp*.so

@@ -1,0 +1,39 @@
+"""ILS contact: level-set frictional contact on structured grids, coupled to DOLFINx.
+
+The compiled core (`dolfinx_forms._cpp`, built from `cpp_contact/`) holds the
+level-set geometry (grids, shapes, reinitialisation, closest-point projection,
+the intermediate contact surface) and the contact constitutive update (gaps,
+return mapping). Equation numbers refer to Liu & Sun, ILS-MPM (seed paper 000).
+"""
+
+try:
+    from . import _cpp
+except ImportError as e:  # pragma: no cover - a clear message instead of a bare ImportError
+    raise ImportError(
+        "dolfinx_forms._cpp is not built: run `make build` (or `pip install --no-build-isolation .`)"
+    ) from e
+
+from ._cpp import (  # noqa: F401  (re-exported API)
+    Box,
+    Circle,
+    Complement,
+    Ellipse,
+    Intersection,
+    LevelSet,
+    Polygon,
+    ProjectionStatus,
+    Shape,
+    StructuredGrid,
+    Union,
+    closest_point_projection,
+    closing_levelset,
+    contact_region,
+    contact_surface,
+    intermediate_levelset,
+    levelset_from_polyline,
+    levelset_from_shape,
+    min_levelset,
+    reinitialize,
+)
+
+__version__ = "0.1.0"
