@@ -40,15 +40,16 @@ test-cpp:
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
 test-python:
-	$(PYTHON) -m pytest -m "not mpi"
+	$(PYTHON) -m pytest -m "not mpi" --color=no
 
 test-mpi:
-	$(MPIRUN) $(PYTHON) -m pytest -m mpi -p no:cacheprovider
+	$(MPIRUN) $(PYTHON) -m pytest -m mpi -p no:cacheprovider --color=no
 
 demo: build
 	$(PYTHON) demos/contact_geometry.py --out $(OUT)/contact_geometry
 
 bench: build
+	mkdir -p benchmarks/results
 	$(BUILD)/cpp_contact/contact_bench --benchmark_out=benchmarks/results/geometry.json \
 	  --benchmark_out_format=json
 	$(PYTHON) benchmarks/plot_geometry.py benchmarks/results/geometry.json

@@ -17,7 +17,9 @@ from ._cpp import (  # noqa: F401  (re-exported API)
     Box,
     Circle,
     Complement,
+    ContactState,
     Ellipse,
+    FrictionHistory,
     Intersection,
     LevelSet,
     Polygon,
@@ -27,6 +29,7 @@ from ._cpp import (  # noqa: F401  (re-exported API)
     Union,
     closest_point_projection,
     closing_levelset,
+    compute_gaps,
     contact_region,
     contact_surface,
     intermediate_levelset,
@@ -34,6 +37,7 @@ from ._cpp import (  # noqa: F401  (re-exported API)
     levelset_from_shape,
     min_levelset,
     reinitialize,
+    return_mapping,
 )
 
 __version__ = "0.1.0"

@@ -93,6 +93,17 @@ LevelSet contact::closing_levelset(const LevelSet& phi_i, const LevelSet& phi_j,
   std::vector<double> v(phi_i.values().size());
   for (std::size_t k = 0; k < v.size(); ++k)
     v[k] = std::min(phi_i.values()[k], phi_j.values()[k]) - eps;
+  // Without a zero contour in the grid, the dilated union covers all of it (every
+  // node is then in the closing) or none of it: a constant of the right sign
+  // larger than any distance in the grid says so without a reinitialisation.
+  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+  if (*hi < 0 or *lo > 0) {
+    const StructuredGrid& g = phi_i.grid();
+    const double diag = std::hypot(g.axis(0).back() - g.axis(0).front(),
+                                   g.axis(1).back() - g.axis(1).front());
+    std::fill(v.begin(), v.end(), *hi < 0 ? -diag : diag + eps);
+    return LevelSet(phi_i.grid(), std::move(v));
+  }
   LevelSet psi = reinitialize(LevelSet(phi_i.grid(), std::move(v)));
   std::vector<double> w(psi.values().begin(), psi.values().end());
   for (double& x : w)
