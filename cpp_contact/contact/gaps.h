@@ -8,7 +8,8 @@ namespace contact {
 /// @brief Gap functions at contact points (eqs 26-31), 2D.
 ///
 /// For each point with projections P_i, P_j, displacements u_i(P_i), u_j(P_j),
-/// contact normal n (from body i towards body j) and tangent t:
+/// contact normal n (from body i towards body j) and tangent t (the contact surface
+/// uses t = (-n_y, n_x); any unit t orthogonal to n works, the sign of g_t follows it):
 ///   g_n0  = (P_j - P_i) . n                 (eq 28)
 ///   j_int = (u_j - u_i) . n                 (eq 29)
 ///   g_n   = g_n0 + j_int                    (eq 27)
