@@ -99,8 +99,8 @@ LevelSet contact::closing_levelset(const LevelSet& phi_i, const LevelSet& phi_j,
   const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
   if (*hi < 0 or *lo > 0) {
     const StructuredGrid& g = phi_i.grid();
-    const double diag = std::hypot(g.axis(0).back() - g.axis(0).front(),
-                                   g.axis(1).back() - g.axis(1).front());
+    const double diag =
+        std::hypot(g.axis(0).back() - g.axis(0).front(), g.axis(1).back() - g.axis(1).front());
     std::fill(v.begin(), v.end(), *hi < 0 ? -diag : diag + eps);
     return LevelSet(phi_i.grid(), std::move(v));
   }

@@ -83,8 +83,7 @@ LevelSet::LevelSet(StructuredGrid grid, std::vector<double> values)
 }
 
 double LevelSet::eval_cell(std::size_t i, std::size_t j, double s, double t, double* grad,
-                           double* hess) const
-{
+                           double* hess) const {
   const auto& x = _grid.axis(0);
   const auto& y = _grid.axis(1);
   const double hx = x[i + 1] - x[i], hy = y[j + 1] - y[j];
@@ -97,8 +96,7 @@ double LevelSet::eval_cell(std::size_t i, std::size_t j, double s, double t, dou
   // with S*, T* the value (v) and slope (d) bases in s and t.
   double f = 0, fs = 0, ft = 0, fss = 0, fst = 0, ftt = 0;
   for (int b = 0; b < 2; ++b)
-    for (int a = 0; a < 2; ++a)
-    {
+    for (int a = 0; a < 2; ++a) {
       const std::size_t n = _grid.node(i + a, j + b);
       const auto& d = _deriv[n];
       const double c00 = _values[n], c10 = hx * d[0], c01 = hy * d[1], c11 = hx * hy * d[2];
@@ -110,8 +108,7 @@ double LevelSet::eval_cell(std::size_t i, std::size_t j, double s, double t, dou
       f += Av * Ht[2 * b] + Ad * Ht[2 * b + 1];
       fs += dAv * Ht[2 * b] + dAd * Ht[2 * b + 1];
       ft += Av * dHt[2 * b] + Ad * dHt[2 * b + 1];
-      if (hess)
-      {
+      if (hess) {
         const double ddAv = c00 * ddHs[2 * a] + c10 * ddHs[2 * a + 1];
         const double ddAd = c01 * ddHs[2 * a] + c11 * ddHs[2 * a + 1];
         fss += ddAv * Ht[2 * b] + ddAd * Ht[2 * b + 1];
@@ -119,13 +116,11 @@ double LevelSet::eval_cell(std::size_t i, std::size_t j, double s, double t, dou
         ftt += Av * ddHt[2 * b] + Ad * ddHt[2 * b + 1];
       }
     }
-  if (grad)
-  {
+  if (grad) {
     grad[0] = fs / hx;
     grad[1] = ft / hy;
   }
-  if (hess)
-  {
+  if (hess) {
     hess[0] = fss / (hx * hx);
     hess[1] = fst / (hx * hy);
     hess[2] = ftt / (hy * hy);
@@ -134,8 +129,7 @@ double LevelSet::eval_cell(std::size_t i, std::size_t j, double s, double t, dou
 }
 
 double LevelSet::eval(std::span<const double, 2> x, std::span<double, 2> grad,
-                      std::span<double, 3> hess) const
-{
+                      std::span<double, 3> hess) const {
   const std::size_t i = _grid.locate_axis(0, x[0]);
   const std::size_t j = _grid.locate_axis(1, x[1]);
   const auto& ax = _grid.axis(0);

@@ -24,7 +24,9 @@ std::vector<double> graded_axis(double lo, double hi, std::size_t n, double beta
   return a;
 }
 
-double order(double e_coarse, double e_fine) { return std::log2(e_coarse / e_fine); }
+double order(double e_coarse, double e_fine) {
+  return std::log2(e_coarse / e_fine);
+}
 
 // Max error of projecting `pts` onto the level set of `shape` vs `exact`, grid n x n on [-2, 2]^2
 double projection_error(const Shape& shape, std::size_t n, const std::vector<double>& pts,
@@ -36,17 +38,18 @@ double projection_error(const Shape& shape, std::size_t n, const std::vector<dou
   for (std::size_t p = 0; p < pts.size() / 2; ++p) {
     EXPECT_EQ(r.status[p], ProjectionStatus::converged) << "point " << p << " n " << n;
     EXPECT_LE(r.iterations[p], 10) << "Newton-polished projection should need few iterations";
-    e = std::max(e, std::hypot(r.points[2 * p] - exact[2 * p], r.points[2 * p + 1] - exact[2 * p + 1]));
+    e = std::max(
+        e, std::hypot(r.points[2 * p] - exact[2 * p], r.points[2 * p + 1] - exact[2 * p + 1]));
   }
   return e;
 }
 } // namespace
 
 TEST(Grid, BadInputThrows) {
-  EXPECT_THROW(StructuredGrid({}, {0, 1, 2}), std::invalid_argument);            // empty axis
-  EXPECT_THROW(StructuredGrid({0, 1}, {0, 1, 2}), std::invalid_argument);        // too few nodes
-  EXPECT_THROW(StructuredGrid({0, 2, 1}, {0, 1, 2}), std::invalid_argument);     // not increasing
-  EXPECT_THROW(StructuredGrid({0, NAN, 1}, {0, 1, 2}), std::invalid_argument);   // NaN
+  EXPECT_THROW(StructuredGrid({}, {0, 1, 2}), std::invalid_argument);          // empty axis
+  EXPECT_THROW(StructuredGrid({0, 1}, {0, 1, 2}), std::invalid_argument);      // too few nodes
+  EXPECT_THROW(StructuredGrid({0, 2, 1}, {0, 1, 2}), std::invalid_argument);   // not increasing
+  EXPECT_THROW(StructuredGrid({0, NAN, 1}, {0, 1, 2}), std::invalid_argument); // NaN
   EXPECT_THROW(StructuredGrid::uniform({0, 0}, {0, 1}, {4, 4}), std::invalid_argument);
 }
 
