@@ -128,35 +128,27 @@ double LevelSet::eval_cell(std::size_t i, std::size_t j, double s, double t, dou
   return f;
 }
 
-double LevelSet::eval(std::span<const double, 2> x, std::span<double, 2> grad,
-                      std::span<double, 3> hess) const {
+double LevelSet::eval_at(std::span<const double, 2> x, double* grad, double* hess) const {
   const std::size_t i = _grid.locate_axis(0, x[0]);
   const std::size_t j = _grid.locate_axis(1, x[1]);
   const auto& ax = _grid.axis(0);
   const auto& ay = _grid.axis(1);
   const double s = (x[0] - ax[i]) / (ax[i + 1] - ax[i]);
   const double t = (x[1] - ay[j]) / (ay[j + 1] - ay[j]);
-  return eval_cell(i, j, s, t, grad.data(), hess.data());
+  return eval_cell(i, j, s, t, grad, hess);
+}
+
+double LevelSet::eval(std::span<const double, 2> x, std::span<double, 2> grad,
+                      std::span<double, 3> hess) const {
+  return eval_at(x, grad.data(), hess.data());
 }
 
 double LevelSet::eval(std::span<const double, 2> x, std::span<double, 2> grad) const {
-  const std::size_t i = _grid.locate_axis(0, x[0]);
-  const std::size_t j = _grid.locate_axis(1, x[1]);
-  const auto& ax = _grid.axis(0);
-  const auto& ay = _grid.axis(1);
-  const double s = (x[0] - ax[i]) / (ax[i + 1] - ax[i]);
-  const double t = (x[1] - ay[j]) / (ay[j + 1] - ay[j]);
-  return eval_cell(i, j, s, t, grad.data());
+  return eval_at(x, grad.data(), nullptr);
 }
 
 double LevelSet::eval(std::span<const double, 2> x) const {
-  const std::size_t i = _grid.locate_axis(0, x[0]);
-  const std::size_t j = _grid.locate_axis(1, x[1]);
-  const auto& ax = _grid.axis(0);
-  const auto& ay = _grid.axis(1);
-  const double s = (x[0] - ax[i]) / (ax[i + 1] - ax[i]);
-  const double t = (x[1] - ay[j]) / (ay[j + 1] - ay[j]);
-  return eval_cell(i, j, s, t, nullptr);
+  return eval_at(x, nullptr, nullptr);
 }
 
 void LevelSet::evaluate(std::span<const double> points, std::span<double> values,

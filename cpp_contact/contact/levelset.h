@@ -49,6 +49,8 @@ public:
                 std::span<double> grads) const;
 
 private:
+  // Locate x and evaluate there (grad/hess may be null)
+  double eval_at(std::span<const double, 2> x, double* grad, double* hess) const;
   // Hermite data of cell (i, j) at local coordinates (s, t) in [0, 1]^2
   double eval_cell(std::size_t i, std::size_t j, double s, double t, double* grad,
                    double* hess = nullptr) const;
