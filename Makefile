@@ -8,7 +8,7 @@ PYTHON  ?= /usr/bin/python3
 BUILD   ?= build
 OUT     ?= results
 JOBS    ?= 2
-APT_PACKAGES := cmake make g++ python3-dolfinx libdolfinx-dev python3-gmsh gmsh \
+APT_PACKAGES := cmake make gcc g++ python3-dolfinx libdolfinx-dev python3-gmsh gmsh \
 	libeigen3-dev python3-mpi4py python3-meshio pybind11-dev python3-pytest \
 	python3-scipy python3-matplotlib libgtest-dev libbenchmark-dev python3-setuptools \
 	python3-venv openmpi-bin
@@ -46,7 +46,7 @@ test-mpi:
 	$(MPIRUN) $(PYTHON) -m pytest -m mpi -p no:cacheprovider --color=no
 
 demo: build
-	$(PYTHON) demos/contact_geometry.py --out $(OUT)/contact_geometry
+	$(PYTHON) demos/hertz.py --out $(OUT)/hertz
 
 bench: build
 	mkdir -p benchmarks/results

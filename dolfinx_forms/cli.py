@@ -38,3 +38,15 @@ def bounded(name, lo=None, hi=None, lo_open=False, hi_open=False):
         return x
 
     return convert
+
+
+def petsc_options(parser, items):
+    """Parse repeated --petsc KEY=VALUE into a dict (keys without the leading dash)."""
+    opts = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        key = key.lstrip("-")
+        if not sep or not key:
+            parser.error(f"--petsc: expected KEY=VALUE, got {item!r}")
+        opts[key] = value
+    return opts

@@ -1,5 +1,7 @@
 // Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
 #include "projection.h"
+#include "shapes.h"
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -108,6 +110,51 @@ ProjectionResult contact::closest_point_projection(const LevelSet& phi, std::spa
     r.points[2 * p] = x[0];
     r.points[2 * p + 1] = x[1];
     r.iterations[p] = k;
+  }
+  return r;
+}
+
+//-----------------------------------------------------------------------------
+contact::ProjectionResult contact::closest_point_projection(const Shape& shape,
+                                                            std::span<const double> x0,
+                                                            double length_scale,
+                                                            const ProjectionOptions& opts) {
+  if (x0.size() % 2 != 0)
+    throw std::invalid_argument("closest_point_projection: points must have shape (n, 2)");
+  if (!(length_scale > 0) or !std::isfinite(length_scale))
+    throw std::invalid_argument("closest_point_projection: length_scale must be finite and > 0");
+  const std::size_t n = x0.size() / 2;
+  const double tol = opts.rtol * length_scale, step = 1e-7 * length_scale;
+  ProjectionResult r;
+  r.points.assign(x0.begin(), x0.end());
+  r.status.assign(n, ProjectionStatus::max_iterations);
+  r.iterations.assign(n, 0);
+  for (std::size_t p = 0; p < n; ++p) {
+    std::array<double, 2> x{x0[2 * p], x0[2 * p + 1]};
+    if (!std::isfinite(x[0]) or !std::isfinite(x[1])) {
+      throw std::invalid_argument("closest_point_projection: point " + std::to_string(p) +
+                                  " is not finite");
+    }
+    for (int k = 0; k <= opts.max_iterations; ++k) {
+      const double d = shape(x);
+      if (std::abs(d) <= tol) {
+        r.status[p] = ProjectionStatus::converged;
+        break;
+      }
+      if (k == opts.max_iterations)
+        break;
+      const double gx = (shape({x[0] + step, x[1]}) - shape({x[0] - step, x[1]})) / (2 * step);
+      const double gy = (shape({x[0], x[1] + step}) - shape({x[0], x[1] - step})) / (2 * step);
+      const double g2 = gx * gx + gy * gy;
+      if (g2 < opts.grad_tol * opts.grad_tol) {
+        r.status[p] = ProjectionStatus::vanishing_gradient;
+        break;
+      }
+      x = {x[0] - d * gx / g2, x[1] - d * gy / g2};
+      r.iterations[p] = k + 1;
+    }
+    r.points[2 * p] = x[0];
+    r.points[2 * p + 1] = x[1];
   }
   return r;
 }

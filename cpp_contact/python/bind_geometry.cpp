@@ -187,6 +187,31 @@ void bind_geometry(py::module_& m) {
       py::arg("grad_tol") = 1e-8,
       "Closest points on phi = 0 (eq 25) of (n, 2) points inside the grid. Returns a dict: "
       "points (n, 2), status (int8, ProjectionStatus), iterations, converged (bool)");
+  m.def(
+      "closest_point_projection",
+      [](const Shape& shape, const carray& pts, double length_scale, double rtol,
+         int max_iterations, double grad_tol) {
+        ProjectionResult r = closest_point_projection(
+            shape, as_span(pts, "points", 2), length_scale,
+            ProjectionOptions{rtol, max_iterations, grad_tol});
+        const auto n = py::ssize_t(r.iterations.size());
+        std::vector<std::int8_t> st(r.status.size());
+        py::array_t<bool> conv(n);
+        for (py::ssize_t p = 0; p < n; ++p) {
+          st[p] = std::int8_t(r.status[p]);
+          conv.mutable_at(p) = r.status[p] == ProjectionStatus::converged;
+        }
+        py::dict d;
+        d["points"] = to_numpy(std::move(r.points), {n, 2});
+        d["status"] = to_numpy(std::move(st), {n});
+        d["iterations"] = to_numpy(std::move(r.iterations), {n});
+        d["converged"] = conv;
+        return d;
+      },
+      py::arg("shape"), py::arg("points"), py::arg("length_scale"), py::arg("rtol") = 1e-10,
+      py::arg("max_iterations") = 20, py::arg("grad_tol") = 1e-8,
+      "Closest points on the boundary of an exact signed-distance shape (x - d grad d, "
+      "repeated); same dict as the level-set overload");
 
   m.def("min_levelset", &min_levelset, py::arg("phi_i"), py::arg("phi_j"), "phi_min (eq 21)");
   m.def("intermediate_levelset", &intermediate_levelset, py::arg("phi_i"), py::arg("phi_j"),

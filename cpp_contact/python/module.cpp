@@ -6,9 +6,13 @@ namespace py = pybind11;
 
 void bind_geometry(py::module_& m);
 void bind_contact(py::module_& m);
+void bind_assembly(py::module_& m);
+void bind_location(py::module_& m);
 
 PYBIND11_MODULE(_cpp, m) {
   m.doc() = "ILS contact core: level sets, closest points, contact surface, return mapping";
   bind_geometry(m);
   bind_contact(m);
+  bind_assembly(m);
+  bind_location(m);
 }

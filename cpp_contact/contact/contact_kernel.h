@@ -1,0 +1,80 @@
+// Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
+#pragma once
+
+#include "return_mapping.h"
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+namespace contact {
+
+/// @brief Contact quadrature of one body pair in the reference configuration (2D).
+///
+/// Built once per scene: points on Gamma_c (eq 24) with their weights, normal n (body i -> j),
+/// tangent t, initial normal gap g_n0 = (P_j - P_i).n (eq 28), and, for each side, the cell
+/// that contains the closest point P_i (P_j) with the basis values there. Small strain: the
+/// geometry does not change during Newton, only u does (eqs 27-30).
+/// Dof indices are *block* (node) indices into a local vector with block size 2.
+struct ContactQuadrature {
+  int nodes_i = 0;                   ///< basis functions per cell of body i
+  int nodes_j = 0;                   ///< basis functions per cell of body j
+  std::vector<double> weights;       ///< (nq,) length measure
+  std::vector<double> normals;       ///< (nq, 2)
+  std::vector<double> tangents;      ///< (nq, 2)
+  std::vector<double> g_n0;          ///< (nq,)
+  std::vector<std::int32_t> dofs_i;  ///< (nq, nodes_i) block dofs of the cell containing P_i
+  std::vector<std::int32_t> dofs_j;  ///< (nq, nodes_j)
+  std::vector<double> basis_i;       ///< (nq, nodes_i) basis values at P_i
+  std::vector<double> basis_j;       ///< (nq, nodes_j)
+
+  /// @brief Number of quadrature points.
+  std::size_t size() const { return weights.size(); }
+  /// @brief Check that all arrays have consistent sizes.
+  /// @throws std::invalid_argument naming the first inconsistent array
+  void validate() const;
+};
+
+/// @brief Traction state of every quadrature point after an evaluation.
+struct ContactPointState {
+  std::vector<double> g_n, g_t;        ///< gaps (eqs 27, 30)
+  std::vector<double> tau_n, tau_t;    ///< tractions (compression negative)
+  std::vector<double> gtp_trial;       ///< plastic slip after this evaluation
+  std::vector<ContactState> state;     ///< open / stick / slip
+};
+
+/// @brief Callback receiving one point's element matrix: block dofs (nodes_i + nodes_j) and the
+/// row-major (2 nd x 2 nd) matrix, nd = nodes_i + nodes_j, interleaved (node*2 + component).
+using BlockInserter =
+    std::function<void(std::span<const std::int32_t> dofs, std::span<const double> Ke)>;
+
+/// @brief Tangent of the contact terms: exact (consistent, default) or central finite
+/// differences of the point residual (verification only).
+enum class TangentMode { exact, finite_difference };
+
+/// @brief Contact residual and tangent of eq 48 for a body pair.
+///
+/// At each point: g_n = g_n0 + (u_j(P_j) - u_i(P_i)).n, g_t = (u_j - u_i).t, the return
+/// mapping (Algorithm 1) gives tau_n, tau_t and D = d[tau_n, tau_t]/d[g_n, g_t], and with
+/// B = [n t]^T [-N_i, N_j] (2 x 2nd):  r += w B^T [tau_n, tau_t],  K += w B^T D B.
+/// Open points add nothing. With mu == 0 the tangential row is skipped altogether (no
+/// return mapping of friction, gtp is neither read nor written).
+/// @param[in] q Quadrature of the pair
+/// @param[in] law Penalty compliances and friction coefficient
+/// @param[in] u Local displacement array (block size 2, owned + ghost)
+/// @param[in] gtp_old Committed plastic slip (nq), ignored (may be empty) when mu == 0
+/// @param[out] b Local residual array to add to (size of u), or empty to skip
+/// @param[in] insert Receives element matrices, or empty to skip the tangent
+/// @param[in] mode Exact or finite-difference tangent
+/// @param[in] fd_step Perturbation of the FD tangent (displacement units)
+/// @return Per-point gaps, tractions, trial slip and states
+ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPenalty& law,
+                                   std::span<const double> u, std::span<const double> gtp_old,
+                                   std::span<double> b, const BlockInserter& insert,
+                                   TangentMode mode = TangentMode::exact, double fd_step = 1e-8);
+
+/// @brief All block dofs of each point (nodes_i + nodes_j per point, point-major): the coupling
+/// blocks that the sparsity pattern must contain.
+std::vector<std::int32_t> coupling_dofs(const ContactQuadrature& q);
+
+} // namespace contact

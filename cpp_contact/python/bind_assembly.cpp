@@ -1,0 +1,151 @@
+// Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
+// DOLFINx/PETSc glue of the contact kernel (eq 48): the pure numerics live in
+// contact/contact_kernel.h; here element blocks go into a PETSc Mat by local block indices
+// and the coupling blocks into a dolfinx SparsityPattern.
+#include "array.h"
+#include <caster_petsc.h>
+#include <contact/contact_kernel.h>
+#include <dolfinx/la/SparsityPattern.h>
+#include <petscmat.h>
+#include <pybind11/stl.h>
+#include <stdexcept>
+#include <string>
+
+namespace py = pybind11;
+using contact::python::as_span;
+using contact::python::carray;
+using contact::python::to_numpy;
+using iarray = py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>;
+
+namespace {
+template <typename T> std::vector<T> copy_of(const py::array_t<T, py::array::c_style |
+                                                                       py::array::forcecast>& a) {
+  return std::vector<T>(a.data(), a.data() + a.size());
+}
+
+/// Throw with the PETSc function named on a non-zero error code.
+void petsc_check(PetscErrorCode ierr, const char* where) {
+  if (ierr != 0)
+    throw std::runtime_error(std::string("PETSc error ") + std::to_string(ierr) + " in " + where);
+}
+} // namespace
+
+void bind_assembly(py::module_& m) {
+  using contact::ContactQuadrature;
+
+  py::class_<ContactQuadrature>(m, "ContactQuadrature",
+                                "Contact points of a body pair with the cells and basis values at "
+                                "their closest points on each body (reference configuration)")
+      .def(py::init([](const carray& weights, const carray& normals, const carray& tangents,
+                       const carray& g_n0, const iarray& dofs_i, const iarray& dofs_j,
+                       const carray& basis_i, const carray& basis_j) {
+             if (dofs_i.ndim() != 2 or dofs_j.ndim() != 2)
+               throw std::invalid_argument("dofs_i, dofs_j: expected arrays of shape (nq, nodes)");
+             ContactQuadrature q;
+             q.nodes_i = int(dofs_i.shape(1));
+             q.nodes_j = int(dofs_j.shape(1));
+             q.weights = copy_of(weights);
+             q.normals = copy_of(normals);
+             q.tangents = copy_of(tangents);
+             q.g_n0 = copy_of(g_n0);
+             q.dofs_i = copy_of(dofs_i);
+             q.dofs_j = copy_of(dofs_j);
+             q.basis_i = copy_of(basis_i);
+             q.basis_j = copy_of(basis_j);
+             q.validate();
+             return q;
+           }),
+           py::arg("weights"), py::arg("normals"), py::arg("tangents"), py::arg("g_n0"),
+           py::arg("dofs_i"), py::arg("dofs_j"), py::arg("basis_i"), py::arg("basis_j"))
+      .def("__len__", &ContactQuadrature::size)
+      .def_property_readonly("g_n0",
+                             [](const ContactQuadrature& q) {
+                               return to_numpy(std::vector<double>(q.g_n0), {py::ssize_t(q.size())});
+                             })
+      .def(
+          "coupling_dofs",
+          [](const ContactQuadrature& q) {
+            return to_numpy(contact::coupling_dofs(q),
+                            {py::ssize_t(q.size()), py::ssize_t(q.nodes_i + q.nodes_j)});
+          },
+          "Block dofs (nq, nodes_i + nodes_j) coupled by each point");
+
+  m.def(
+      "insert_coupling",
+      [](dolfinx::la::SparsityPattern& pattern, const ContactQuadrature& q) {
+        const std::vector<std::int32_t> dofs = contact::coupling_dofs(q);
+        const std::size_t nd = q.nodes_i + q.nodes_j;
+        for (std::size_t p = 0; p < q.size(); ++p) {
+          std::span<const std::int32_t> d(dofs.data() + p * nd, nd);
+          pattern.insert(d, d);
+        }
+      },
+      py::arg("pattern"), py::arg("quadrature"),
+      "Add the contact coupling blocks of every point to a (not yet assembled) SparsityPattern");
+
+  m.def(
+      "add_coupling_zeros",
+      [](Mat A, const ContactQuadrature& q) {
+        // PETSc squeezes preallocated but unused entries out at the first final assembly:
+        // explicit zeros keep the contact blocks in the matrix for every later iteration.
+        const std::vector<std::int32_t> dofs = contact::coupling_dofs(q);
+        const std::size_t nd = q.nodes_i + q.nodes_j;
+        const std::vector<double> zeros(4 * nd * nd, 0.0);
+        for (std::size_t p = 0; p < q.size(); ++p) {
+          petsc_check(MatSetValuesBlockedLocal(A, PetscInt(nd), dofs.data() + p * nd, PetscInt(nd),
+                                               dofs.data() + p * nd, zeros.data(), ADD_VALUES),
+                      "MatSetValuesBlockedLocal (coupling block outside the sparsity pattern)");
+        }
+      },
+      py::arg("A"), py::arg("quadrature"),
+      "Add explicit zeros on the contact coupling blocks (before the matrix's first assembly)");
+
+  m.def(
+      "assemble_contact",
+      [](const ContactQuadrature& q, double eps_n, double eps_t, double mu, const carray& u,
+         const carray& gtp_old, std::optional<py::array_t<double, py::array::c_style>> b,
+         std::optional<Mat> A, bool finite_difference, double fd_step) {
+        std::span<double> bs;
+        if (b) {
+          if (b->size() != u.size())
+            throw std::invalid_argument("b: expected the size of u");
+          bs = std::span<double>(b->mutable_data(), std::size_t(b->size()));
+        }
+        contact::BlockInserter insert;
+        if (A) {
+          Mat mat = *A;
+          insert = [mat](std::span<const std::int32_t> dofs, std::span<const double> Ke) {
+            const auto nd = PetscInt(dofs.size());
+            petsc_check(MatSetValuesBlockedLocal(mat, nd, dofs.data(), nd, dofs.data(), Ke.data(),
+                                                 ADD_VALUES),
+                        "MatSetValuesBlockedLocal (contact block outside the sparsity pattern?)");
+          };
+        }
+        const auto mode = finite_difference ? contact::TangentMode::finite_difference
+                                            : contact::TangentMode::exact;
+        contact::ContactPointState s = contact::assemble_contact(
+            q, contact::CoulombPenalty{eps_n, eps_t, mu}, as_span(u, "u"),
+            as_span(gtp_old, "gtp_old"), bs, insert, mode, fd_step);
+        const auto nq = py::ssize_t(q.size());
+        std::vector<std::int8_t> st(s.state.size());
+        for (std::size_t p = 0; p < st.size(); ++p)
+          st[p] = std::int8_t(s.state[p]);
+        py::dict d;
+        d["g_n"] = to_numpy(std::move(s.g_n), {nq});
+        d["g_t"] = to_numpy(std::move(s.g_t), {nq});
+        d["tau_n"] = to_numpy(std::move(s.tau_n), {nq});
+        d["tau_t"] = to_numpy(std::move(s.tau_t), {nq});
+        d["state"] = to_numpy(std::move(st), {nq});
+        if (mu > 0)
+          d["gtp_trial"] = to_numpy(std::move(s.gtp_trial), {nq});
+        else
+          d["gtp_trial"] = py::none();
+        return d;
+      },
+      py::arg("quadrature"), py::arg("eps_n"), py::arg("eps_t"), py::arg("mu"), py::arg("u"),
+      py::arg("gtp_old"), py::arg("b") = py::none(), py::arg("A") = py::none(),
+      py::arg("finite_difference") = false, py::arg("fd_step") = 1e-8,
+      "Contact residual (added into the local array b) and tangent (added into the PETSc Mat A "
+      "by local block indices; call A.assemble() after) of eq 48. Returns a dict of per-point "
+      "g_n, g_t, tau_n, tau_t, state (int8 ContactState) and gtp_trial (None when mu == 0).");
+}

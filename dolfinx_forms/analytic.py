@@ -1,0 +1,45 @@
+"""Analytic references (Johnson, Contact Mechanics, ch. 4 and 7; plane strain, line loads)."""
+
+import numpy as np
+
+
+def effective_modulus(E1, nu1, E2=None, nu2=None):
+    """E* with 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2 (E2 = inf or None: rigid second body)."""
+    inv = (1 - nu1**2) / E1
+    if E2 is not None and np.isfinite(E2):
+        inv += (1 - nu2**2) / E2
+    return 1.0 / inv
+
+
+def hertz_line(P, R, E_star):
+    """Half-width a and peak pressure p0 of a cylinder (radius R) on a flat, line load P."""
+    a = np.sqrt(4 * P * R / (np.pi * E_star))
+    return a, 2 * P / (np.pi * a)
+
+
+def hertz_pressure(x, a, p0):
+    """p(x) = p0 sqrt(1 - x^2/a^2) inside |x| < a, 0 outside."""
+    r = np.clip(1 - (np.asarray(x) / a) ** 2, 0.0, None)
+    return p0 * np.sqrt(r)
+
+
+def load_for_half_width(a, R, E_star):
+    """Line load that gives half-width a (inverse of hertz_line)."""
+    return np.pi * E_star * a**2 / (4 * R)
+
+
+def mindlin_stick_half_width(a, Q, mu, P):
+    """Cattaneo-Mindlin c = a sqrt(1 - |Q|/(mu P)) (monotonic Q after P)."""
+    return a * np.sqrt(1 - abs(Q) / (mu * P))
+
+
+def mindlin_shear(x, a, c, p0, mu):
+    """|q(x)|: mu p0 sqrt(1-x^2/a^2) minus mu p0 (c/a) sqrt(1-x^2/c^2) inside the stick zone."""
+    x = np.asarray(x)
+    q = mu * hertz_pressure(x, a, p0)
+    return q - mu * (c / a) * hertz_pressure(x, c, p0) if c > 0 else q
+
+
+def patch_pressure(E, nu, strain):
+    """Uniform contact pressure of the plane-strain patch test with free sides: E/(1-nu^2) e."""
+    return E / (1 - nu**2) * strain

@@ -1,0 +1,130 @@
+"""Contact geometry of a body pair on a body-fitted mesh, built once per scene.
+
+Small strain: Gamma_c, the closest points and the cells that contain them are computed in
+the reference configuration; Newton only changes u in the gaps (eqs 27-30). For each pair:
+
+1. the pair's *search box*: the overlap of the two bodies' bounding boxes, each inflated by
+   the contact band. Pairs whose inflated boxes do not overlap are never searched.
+2. a structured grid on that box and each body's level set sampled on it (exact signed
+   distance of the body's shape, C1 interpolation by the geometry core);
+3. Gamma_c (eqs 21-24) with Gauss points, normals n (body i -> j), tangents t;
+4. closest points P_i, P_j (eq 25), g_n0 = (P_j - P_i).n (eq 28);
+5. the mesh cells containing P_i and P_j (binned point location in C++) and the basis values
+   there (basix), packed into a `ContactQuadrature` for the C++ kernel (eq 48).
+"""
+
+from dataclasses import dataclass
+
+import basix
+import numpy as np
+
+from . import _cpp
+
+
+@dataclass
+class PairGeometry:
+    """Contact points of one body pair and what the kernel needs (see module doc)."""
+
+    pair: tuple
+    points: np.ndarray      # (nq, 2) on Gamma_c
+    weights: np.ndarray     # (nq,)
+    normals: np.ndarray     # (nq, 2) body i -> j
+    tangents: np.ndarray    # (nq, 2) t = (-n_y, n_x)
+    p_i: np.ndarray         # (nq, 2) closest points on body i
+    p_j: np.ndarray         # (nq, 2)
+    g_n0: np.ndarray        # (nq,)
+    quadrature: object      # _cpp.ContactQuadrature
+    grid_spacing: float
+    search_box: np.ndarray  # (2, 2)
+
+
+def search_box(body_i, body_j, band):
+    """Overlap of the two bounding boxes inflated by `band`, or None if they are disjoint."""
+    lo = np.maximum(body_i.bbox[0], body_j.bbox[0]) - band
+    hi = np.minimum(body_i.bbox[1], body_j.bbox[1]) + band
+    if np.any(lo >= hi):
+        return None
+    return np.array([lo, hi])
+
+
+def _basix_element(cell_type, degree):
+    cell = {"triangle": basix.CellType.triangle,
+            "quadrilateral": basix.CellType.quadrilateral}[cell_type]
+    # Degree <= 2: every Lagrange variant has the same points, so this matches DOLFINx's element
+    return basix.create_element(basix.ElementFamily.P, cell, degree, basix.LagrangeVariant.gll_warped)
+
+
+class BodyLocator:
+    """Point location restricted to one body's cells (C++ bins), with basis values."""
+
+    def __init__(self, mesh, cell_tags, tag, cell_type, degree):
+        x = mesh.geometry.x
+        gdofs = mesh.geometry.dofmap.array.reshape(-1, 3 if cell_type == "triangle" else 4)
+        cells = cell_tags.indices[cell_tags.values == tag].astype(np.int32)
+        self.locator = _cpp.CellLocator(x, gdofs.astype(np.int32), cells)
+        self.element = _basix_element(cell_type, degree)
+
+    def locate(self, points, max_distance):
+        r = self.locator.locate(np.ascontiguousarray(points), max_distance)
+        return r["cells"], r["X"], r["outside"]
+
+    def basis(self, X):
+        return self.element.tabulate(0, X)[0, :, :, 0]
+
+
+def pair_geometry(V, scene, pair, band, *, grid_refine=4, num_gauss=2, max_outside=None,
+                  projection="shape"):
+    """Contact quadrature of `pair` (indices into scene.bodies).
+
+    band: largest initial gap covered by Gamma_c (eq 22 uses eps = band / 2), a length.
+    grid_refine: level-set grid cells per mesh size h_contact.
+    projection: "shape" (exact closest points on the bodies' analytic shapes) or "levelset"
+    (eq 25 on the grid interpolants).
+    Returns None when the pair cannot touch (disjoint inflated boxes or empty Gamma_c).
+    """
+    i, j = pair
+    bi, bj = scene.bodies[i], scene.bodies[j]
+    h = scene.h_contact
+    dx = h / grid_refine
+    box = search_box(bi, bj, band + 4 * dx)
+    if box is None:
+        return None
+    n = np.maximum(np.ceil((box[1] - box[0]) / dx).astype(int), 3)
+    hi = box[0] + n * dx  # keep the spacing exactly dx
+    grid = _cpp.StructuredGrid(np.linspace(box[0, 0], hi[0], n[0] + 1),
+                               np.linspace(box[0, 1], hi[1], n[1] + 1))
+    phi_i = _cpp.levelset_from_shape(grid, bi.shape)
+    phi_j = _cpp.levelset_from_shape(grid, bj.shape)
+    s = _cpp.contact_surface(phi_i, phi_j, 0.5 * band, num_gauss)
+    if len(s["weights"]) == 0:
+        return None
+    if projection == "shape":  # exact shapes: exact closest points, corners included
+        proj = [_cpp.closest_point_projection(b.shape, s["points"], h) for b in (bi, bj)]
+    else:  # eq 25 on the level-set interpolant (first order at corners)
+        proj = [_cpp.closest_point_projection(phi, s["points"]) for phi in (phi_i, phi_j)]
+    for name, pr in zip((bi.name, bj.name), proj):
+        if not np.all(pr["converged"]):
+            bad = np.flatnonzero(~pr["converged"])[0]
+            raise RuntimeError(
+                f"closest-point projection onto body {name!r} failed at contact point "
+                f"{s['points'][bad]} (status {_cpp.ProjectionStatus(int(pr['status'][bad])).name})")
+    p_i, p_j = proj[0]["points"], proj[1]["points"]
+    normals, tangents = s["normals"], s["tangents"]
+    g_n0 = np.einsum("ij,ij->i", p_j - p_i, normals)
+
+    degree = V.ufl_element().degree()
+    dofmap = V.dofmap.list.array.reshape(-1, V.dofmap.dof_layout.num_dofs)
+    max_outside = 0.5 * h if max_outside is None else max_outside
+    sides = []
+    for body, p in ((bi, p_i), (bj, p_j)):
+        loc = BodyLocator(scene.mesh, scene.cell_tags, body.tag, scene.cell_type, degree)
+        cells, X, outside = loc.locate(p, max_outside)
+        if np.any(cells < 0):
+            bad = np.flatnonzero(cells < 0)[0]
+            raise RuntimeError(f"closest point {p[bad]} on body {body.name!r} is not within "
+                               f"{max_outside:g} of any of its cells on this rank")
+        sides.append((dofmap[cells].astype(np.int32), loc.basis(X)))
+    q = _cpp.ContactQuadrature(s["weights"], normals, tangents, g_n0,
+                               sides[0][0], sides[1][0], sides[0][1], sides[1][1])
+    return PairGeometry(pair, s["points"], s["weights"], normals, tangents, p_i, p_j, g_n0, q,
+                        dx, box)

@@ -1,0 +1,131 @@
+"""Demo outputs: atomic result folders in parallel, tractions.csv, XDMF, traction plots."""
+
+import csv
+import os
+import shutil
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from .results import write_metrics
+from .solver import STATE_NAMES
+
+TRACTION_COLUMNS = ("x", "y", "p_n", "p_t", "gap_n", "slip", "state")
+
+
+@contextmanager
+def atomic_output(out, comm=MPI.COMM_WORLD):
+    """A temporary folder beside `out` shared by all ranks; it replaces `out` in one rename
+    on success and is removed on any failure (no half-written results)."""
+    out = Path(out).resolve()
+    tmp = None
+    if comm.rank == 0:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent)
+    tmp = Path(comm.bcast(tmp, root=0))
+    ok = False
+    try:
+        yield tmp
+        ok = True
+    finally:
+        ok = comm.allreduce(ok, op=MPI.LAND)
+        if comm.rank == 0:
+            if ok:
+                if out.exists():
+                    old = out.with_name(f".{out.name}.old.{os.getpid()}")
+                    os.replace(out, old)
+                    os.replace(tmp, out)
+                    shutil.rmtree(old, ignore_errors=True)
+                else:
+                    os.replace(tmp, out)
+            else:
+                shutil.rmtree(tmp, ignore_errors=True)
+        comm.barrier()
+
+
+def gather_points(problem):
+    """All ranks' contact points on rank 0, sorted by x (None on other ranks)."""
+    local = problem.contact_points()
+    keys = ("x", "y", "w", "p_n", "p_t", "gap_n", "slip", "state")
+    mine = {k: np.concatenate([p[k] for p in local]) if local else np.zeros(0) for k in keys}
+    allp = problem.comm.gather(mine, root=0)
+    if problem.comm.rank != 0:
+        return None
+    pts = {k: np.concatenate([p[k] for p in allp]) for k in keys}
+    order = np.argsort(pts["x"], kind="stable")
+    return {k: v[order] for k, v in pts.items()}
+
+
+def write_tractions(folder, pts):
+    with open(Path(folder) / "tractions.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(TRACTION_COLUMNS)
+        for k in range(len(pts["x"])):
+            w.writerow([f"{pts['x'][k]:.12e}", f"{pts['y'][k]:.12e}", f"{pts['p_n'][k]:.12e}",
+                        f"{pts['p_t'][k]:.12e}", f"{pts['gap_n'][k]:.12e}",
+                        f"{pts['slip'][k]:.12e}", STATE_NAMES[int(pts["state"][k])]])
+
+
+def write_fields(folder, problem, name="solution"):
+    """Displacement (P1) and Cauchy stress (cellwise constant) in XDMF for ParaView."""
+    import ufl
+    from dolfinx import fem, io
+
+    mesh = problem.mesh
+    V1 = fem.VectorFunctionSpace(mesh, ("Lagrange", 1))
+    u1 = fem.Function(V1, name="displacement")
+    u1.interpolate(problem.u)
+    S = fem.TensorFunctionSpace(mesh, ("DG", 0))
+    sig = fem.Function(S, name="stress")
+    Q = fem.FunctionSpace(mesh, ("DG", 0))
+    lam_mu = [fem.Function(Q) for _ in range(2)]
+    for tag, (E, nu) in problem.materials.items():
+        cells = problem.scene.cell_tags.find(tag)
+        from .solver import plane_strain
+        m, lmb = plane_strain(E, nu)
+        lam_mu[0].x.array[cells] = m
+        lam_mu[1].x.array[cells] = lmb
+    e = ufl.sym(ufl.grad(problem.u))
+    expr = fem.Expression(2 * lam_mu[0] * e + lam_mu[1] * ufl.tr(e) * ufl.Identity(2),
+                          S.element.interpolation_points())
+    sig.interpolate(expr)
+    with io.XDMFFile(mesh.comm, str(Path(folder) / f"{name}.xdmf"), "w") as f:
+        f.write_mesh(mesh)
+        f.write_function(u1)
+        f.write_function(sig)
+
+
+def plot_tractions(path, pts, analytic=None, title="", xlabel="x (mm)", ylabel="traction (MPa)"):
+    """Computed p_n, p_t at the contact points against analytic curves {label: (x, y)}."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(pts["x"], pts["p_n"], ".", ms=3, label="p_n computed")
+    if np.any(pts["p_t"] != 0):
+        ax.plot(pts["x"], pts["p_t"], ".", ms=3, label="p_t computed")
+    for label, (x, y) in (analytic or {}).items():
+        ax.plot(x, y, "-", lw=1, label=label)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def finish(folder, metrics, problem, pts, plot=None):
+    """Everything beside metrics.json, then metrics.json (rank 0 writes the small files)."""
+    write_fields(folder, problem)
+    if problem.comm.rank == 0:
+        write_tractions(folder, pts)
+        if plot is not None:
+            plot(Path(folder) / "tractions.png")
+        write_metrics(folder, metrics)

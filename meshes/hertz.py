@@ -1,0 +1,150 @@
+"""Hertz scene: a half-cylinder resting on a block (plane strain), touching at one point.
+
+Geometry (any consistent units):
+  body 0 "block"    (tag 1): rectangle [-width/2, width/2] x [-depth, 0]
+  body 1 "cylinder" (tag 2): lower half-disc {x^2 + (y-R)^2 <= R^2, y <= R}; flat face y = R
+                             on top (width 2R), its arc touches the block top at the origin.
+Both outlines have a vertex at the origin (two distinct vertices, gap 0 there). The arc is a
+gmsh circle arc (nodes exactly on the circle). In the zone |x|, |y| <= zone (both bodies) h is
+an upper bound: every edge of a cell inside the zone is <= 1.05 h. Quads: the zone is a
+structured grid (spacing <= h, ~0.95 h, the origin a grid vertex), the rest is meshed at 2h,
+recombined and subdivided (all quads); triangles: unstructured with gmsh target ~0.75 h (mean
+edge ~0.75 h), shrunk and remeshed if an edge exceeds 1.05 h.
+Outside the zone the size grows linearly with slope 0.25 up to h_far (default min(R, depth)/8).
+Boundaries (facet tags): block_bottom=1, block_sides=2, block_top=3, cylinder_top=4, cylinder_arc=5.
+pairs = [(0, 1)]; the contact box [-1.5 zone, 1.5 zone]^2 (clipped to the scene) is on rank 0.
+Run: /usr/bin/python3 -m meshes.hertz [--h 0.05] [--quads]   (from the repository root)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .scene import Body, Scene, extract_gmsh, gmsh_model, max_edge_in_box, scene_from_gmsh, summary
+
+GROWTH = 0.25  # mesh size slope outside the zone
+
+
+def hertz_contact_box(R=10.0, width=40.0, depth=20.0, zone=1.5) -> np.ndarray:
+    """[-1.5 zone, 1.5 zone]^2 clipped to the bounding box of the two bodies."""
+    z = 1.5 * zone
+    return np.array([[max(-z, -width / 2), max(-z, -depth)], [min(z, width / 2), min(z, R)]])
+
+
+def _build(gmsh, R, W, depth, z, h, h_far, quads):
+    """Rank 0: both bodies, each split into a zone part (|x|, |y| <= z) and the rest (shared
+    curves inside a body only), then meshed. quads: the zone parts are structured (transfinite)
+    grids with edges <= h, the rest is recombined. Triangles: unstructured everywhere."""
+    assert 0 < z < min(R, W, depth), "zone must lie inside both bodies"
+    geo, sag = gmsh.model.geo, R - np.sqrt(R * R - z * z)
+    # quads: blossom may leave a few triangles, so mesh at 2h and subdivide every cell (all quads,
+    # the structured zone stays structured): zone curves get n/2 cells before subdivision
+    hq = 2 * h if quads else h
+    n_x = int(np.ceil(R * np.arcsin(z / R) / hq))  # cells along each half (x < 0, x > 0)
+    n_y = int(np.ceil(z / hq))  # cells across the zone's height: z (block), z - sag .. z (cylinder)
+
+    def pts(*xy):
+        return [geo.addPoint(x, y, 0.0) for x, y in xy]
+
+    def lines(p, closed=True):
+        n = len(p) if closed else len(p) - 1
+        return [geo.addLine(p[i], p[(i + 1) % len(p)]) for i in range(n)]
+
+    def surface(curves, zone=False):  # zone parts: 4-sided, structured when quads
+        s = geo.addPlaneSurface([geo.addCurveLoop(curves)])
+        if quads and zone:
+            geo.mesh.setTransfiniteSurface(s)
+            geo.mesh.setRecombine(2, s)
+
+    # block: the zone [-z, z] x [-z, 0] as two squares left/right of x = 0, and the rest
+    b0, b1, b2, b3 = pts((-W, -depth), (W, -depth), (W, 0), (z, 0))
+    o, b5, b6 = pts((0, 0), (-z, 0), (-W, 0))
+    zl, zm, zr = pts((-z, -z), (0, -z), (z, -z))
+    bot, right, tr, down, zb_r, zb_l, up, tl, left = lines([b0, b1, b2, b3, zr, zm, zl, b5, b6])
+    top_r, top_l = lines([b3, o, b5], closed=False)
+    mid = geo.addLine(zm, o)
+    surface([bot, right, tr, down, zb_r, zb_l, up, tl, left])
+    surface([-zb_r, -down, top_r, -mid], True)
+    surface([-zb_l, mid, top_l, -up], True)
+    # cylinder: the zone part {|x| <= z, y <= z} above the arc (two halves), and the rest
+    c, a, pl, o2, pr, b, ztl, ztm, ztr = pts((0, R), (-R, R), (-z, sag), (0, 0), (z, sag), (R, R),
+                                             (-z, z), (0, z), (z, z))
+    arcs = [geo.addCircleArc(p, c, q) for p, q in [(a, pl), (pl, o2), (o2, pr), (pr, b)]]
+    side_l, zt_l, zt_r, side_r = lines([pl, ztl, ztm, ztr, pr], closed=False)
+    top, cmid = geo.addLine(b, a), geo.addLine(o2, ztm)
+    surface([arcs[0], side_l, zt_l, zt_r, side_r, arcs[3], top])
+    surface([arcs[1], cmid, -zt_l, -side_l], True)
+    surface([arcs[2], -side_r, -zt_r, -cmid], True)
+    if quads:
+        for line in [zb_r, zb_l, top_r, top_l, arcs[1], arcs[2], zt_l, zt_r]:
+            geo.mesh.setTransfiniteCurve(line, n_x + 1)
+        for line in [down, mid, up, side_l, cmid, side_r]:
+            geo.mesh.setTransfiniteCurve(line, n_y + 1)
+    geo.synchronize()
+
+    f = gmsh.model.mesh.field.add("Box")
+    for k, v in dict(VOut=h_far * hq / h, XMin=-z, XMax=z, YMin=-z, YMax=z).items():
+        gmsh.model.mesh.field.setNumber(f, k, v)
+    gmsh.model.mesh.field.setAsBackgroundMesh(f)
+    gmsh.option.setNumber("Mesh.RecombineAll", int(quads))
+    gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", int(quads))
+    # Unstructured triangle edges scatter up to ~1.35x gmsh's target size: aim at 0.75 h and
+    # shrink further (remesh) until the longest edge of the zone's cells is <= 1.05 h.
+    fac = 1.0 if quads else 0.75
+    for attempt in range(5):
+        if attempt:
+            gmsh.model.mesh.clear()
+        gmsh.model.mesh.field.setNumber(f, "VIn", fac * hq)
+        gmsh.model.mesh.field.setNumber(f, "Thickness", (h_far - fac * h) * hq / h / GROWTH)
+        gmsh.model.mesh.generate(2)
+        _, x, cells = extract_gmsh(gmsh)
+        ratio = max_edge_in_box(x, cells, [[-z, -z], [z, z]]) / h
+        if ratio <= 1.05:
+            break
+        fac /= ratio
+    else:
+        raise RuntimeError(f"hertz: longest edge in the zone is {ratio:.3f} h after 5 meshings")
+
+
+def hertz_scene(comm, R=10.0, width=40.0, depth=20.0, h=0.05, zone=1.5, h_far=None,
+                quads=False, contact_box=None) -> Scene:
+    """The Hertz scene (see the module docstring); contact_box overrides hertz_contact_box()."""
+    import dolfinx_forms as df
+
+    h_far = max(h, min(R, depth) / 8 if h_far is None else h_far)
+    W = width / 2
+    bodies = [
+        Body("block", 1, df.Box((-W, -depth), (W, 0.0)), np.array([[-W, -depth], [W, 0.0]])),
+        Body(
+            "cylinder", 2,
+            df.Intersection([df.Circle((0.0, R), R), df.Box((-R - 1, -1.0), (R + 1, R))]),
+            np.array([[-R, 0.0], [R, R]]),
+        ),
+    ]
+    tol = 1e-8 * max(R, width, depth)
+    markers = {
+        "block_bottom": (1, lambda x: np.isclose(x[1], -depth, atol=tol), 0),
+        "block_sides": (2, lambda x: np.isclose(np.abs(x[0]), W, atol=tol), 0),
+        "block_top": (3, lambda x: np.isclose(x[1], 0.0, atol=tol), 0),
+        "cylinder_top": (4, lambda x: np.isclose(x[1], R, atol=tol), 1),
+        "cylinder_arc": (5, lambda x: np.abs(np.hypot(x[0], x[1] - R) - R) < tol, 1),
+    }
+    with gmsh_model(comm, "hertz") as gmsh:
+        if comm.rank == 0:
+            _build(gmsh, R, W, depth, zone, h, h_far, quads)
+        box = hertz_contact_box(R, width, depth, zone) if contact_box is None else contact_box
+        return scene_from_gmsh(comm, bodies, markers, [(0, 1)], h, contact_box=box)
+
+
+if __name__ == "__main__":
+    import argparse
+
+    from mpi4py import MPI
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--h", type=float, default=0.05)
+    ap.add_argument("--quads", action="store_true")
+    args = ap.parse_args()
+    line = summary(hertz_scene(MPI.COMM_WORLD, h=args.h, quads=args.quads))
+    if MPI.COMM_WORLD.rank == 0:
+        print("hertz:", line)

@@ -1,0 +1,168 @@
+"""Point location on DOLFINx meshes (CellLocator) against dolfinx.geometry and the P1 basis."""
+
+import time
+
+import basix
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+import dolfinx
+import dolfinx.geometry
+from dolfinx.mesh import CellType, create_unit_square, locate_entities
+from dolfinx_forms._cpp import CellLocator
+
+CELL_TYPES = [CellType.triangle, CellType.quadrilateral]
+
+
+def mesh_arrays(mesh):
+    """x (nv, 3) and cells (nc, nverts) of the geometry, as a CellLocator takes them."""
+    nverts = 3 if mesh.topology.cell_type == CellType.triangle else 4
+    return mesh.geometry.x, mesh.geometry.dofmap.array.reshape(-1, nverts)
+
+
+def dolfinx_colliding_cells(mesh, points):
+    """For each (n, 2) point, the set of cells dolfinx.geometry finds containing it."""
+    p3 = np.c_[points, np.zeros(len(points))]
+    tree = dolfinx.geometry.BoundingBoxTree(mesh, mesh.topology.dim)
+    candidates = dolfinx.geometry.compute_collisions(tree, p3)
+    colliding = dolfinx.geometry.compute_colliding_cells(mesh, candidates, p3)
+    return [set(colliding.links(i)) for i in range(len(points))]
+
+
+def p1_basis(cell_type, X):
+    """P1 basis functions at reference points X (n, 2), (n, nverts), via basix."""
+    ct = basix.CellType.triangle if cell_type == CellType.triangle else basix.CellType.quadrilateral
+    e = basix.create_element(basix.ElementFamily.P, ct, 1, basix.LagrangeVariant.equispaced)
+    return e.tabulate(0, X)[0, :, :, 0]
+
+
+def interpolate_at(mesh, u, cells, X):
+    """Values of the P1 function u at the points (cells, X) through the basis functions."""
+    phi = p1_basis(mesh.topology.cell_type, X)
+    dofs = np.array([u.function_space.dofmap.cell_dofs(c) for c in cells])
+    return np.sum(phi * u.x.array[dofs], axis=1)
+
+
+def linear(x):
+    return 1.0 + 2.0 * x[0] - 3.0 * x[1]
+
+
+@pytest.mark.parametrize("cell_type", CELL_TYPES)
+def test_matches_dolfinx_and_interpolates_linear(cell_type):
+    mesh = create_unit_square(MPI.COMM_SELF, 8, 8, cell_type)
+    x, cells = mesh_arrays(mesh)
+    loc = CellLocator(x, cells, np.arange(len(cells), dtype=np.int32))
+    assert loc.num_cells == len(cells) and loc.num_vertices == cells.shape[1]
+    pts = np.random.default_rng(0).random((1000, 2))
+    r = loc.locate(pts, 0.0)
+    assert r["cells"].dtype == np.int32 and r["X"].shape == (1000, 2)
+    assert np.all(r["outside"] == 0.0)
+    expected = dolfinx_colliding_cells(mesh, pts)
+    assert all(c in e for c, e in zip(r["cells"], expected))
+    # X is DOLFINx's reference point: the coordinate map pulls the point back to it ...
+    for i in range(0, 1000, 97):
+        geom = x[cells[r["cells"][i]]]
+        Xd = mesh.geometry.cmap.pull_back(np.array([[*pts[i], 0.0]]), geom)
+        assert np.allclose(Xd[0, :2], r["X"][i], atol=1e-12)
+    # ... and the P1 basis at X interpolates a linear function exactly
+    V = dolfinx.fem.FunctionSpace(mesh, ("Lagrange", 1))
+    u = dolfinx.fem.Function(V)
+    u.interpolate(linear)
+    vals = interpolate_at(mesh, u, r["cells"], r["X"])
+    assert np.abs(vals - linear(pts.T)).max() < 1e-12
+
+
+@pytest.mark.parametrize("cell_type", CELL_TYPES)
+def test_points_slightly_outside(cell_type):
+    """Boundary points pushed out of the mesh: nearest cell, exact distance, extrapolated X
+    at which the P1 basis still reproduces linear functions."""
+    mesh = create_unit_square(MPI.COMM_SELF, 8, 8, cell_type)
+    x, cells = mesh_arrays(mesh)
+    loc = CellLocator(x, cells)  # all cells
+    rng = np.random.default_rng(1)
+    t, d = rng.uniform(0.01, 0.99, 100), rng.uniform(1e-9, 1e-3, 100)
+    pts = np.r_[np.c_[t, -d], np.c_[t, 1 + d], np.c_[-d, t], np.c_[1 + d, t]]
+    dist = np.r_[d, d, d, d]
+    r = loc.locate(pts, 2e-3)
+    assert np.all(r["cells"] >= 0)
+    assert np.allclose(r["outside"], dist, rtol=1e-10, atol=1e-15)
+    # The located cell touches the boundary right next to the point
+    edge = np.abs(x[cells[r["cells"]], :2] - np.clip(pts, 0, 1)[:, None, :]).max(axis=2).min(axis=1)
+    assert edge.max() <= 1 / 8 + 1e-12
+    V = dolfinx.fem.FunctionSpace(mesh, ("Lagrange", 1))
+    u = dolfinx.fem.Function(V)
+    u.interpolate(linear)
+    vals = interpolate_at(mesh, u, r["cells"], r["X"])
+    assert np.abs(vals - linear(pts.T)).max() < 1e-12
+    # Beyond max_distance: not located
+    far = loc.locate(np.array([[0.5, -0.01], [3.0, 3.0]]), 2e-3)
+    assert list(far["cells"]) == [-1, -1]
+    assert np.isnan(far["X"]).all() and np.isinf(far["outside"]).all()
+
+
+@pytest.mark.parametrize("cell_type", CELL_TYPES)
+def test_subset(cell_type):
+    mesh = create_unit_square(MPI.COMM_SELF, 8, 8, cell_type)
+    x, cells = mesh_arrays(mesh)
+    left = locate_entities(mesh, 2, lambda p: p[0] <= 0.5 + 1e-12).astype(np.int32)
+    loc = CellLocator(x, cells, left)
+    assert loc.num_cells == len(left) < len(cells)
+    pts = np.array([[0.25, 0.5], [0.75, 0.5], [0.6, 0.3]])
+    r = loc.locate(pts, 0.3)
+    assert np.all(np.isin(r["cells"], left))
+    assert np.allclose(r["outside"], [0.0, 0.25, 0.1], atol=1e-14)
+    assert list(loc.locate(pts, 0.2)["cells"] == -1) == [False, True, False]
+
+
+def test_bad_shapes_raise_value_error():
+    mesh = create_unit_square(MPI.COMM_SELF, 2, 2, CellType.triangle)
+    x, cells = mesh_arrays(mesh)
+    with pytest.raises(ValueError, match="x"):
+        CellLocator(np.c_[x, x[:, :1]], cells)
+    with pytest.raises(ValueError, match="cells"):
+        CellLocator(x, np.c_[cells, cells[:, :2]])
+    with pytest.raises(ValueError, match="cells"):
+        CellLocator(x, cells.ravel())
+    with pytest.raises(ValueError, match="subset"):
+        CellLocator(x, cells, np.array([[0, 1]], dtype=np.int32))
+    with pytest.raises(ValueError, match="subset"):
+        CellLocator(x, cells, np.array([0, 99], dtype=np.int32))
+    loc = CellLocator(x, cells)
+    with pytest.raises(ValueError, match="points"):
+        loc.locate(np.zeros((4, 3)), 0.0)
+    with pytest.raises(ValueError, match="max_distance"):
+        loc.locate(np.zeros((4, 2)), -1.0)
+
+
+@pytest.mark.parametrize("cell_type", CELL_TYPES)
+def test_timing_200x200(cell_type):
+    """Throughput print (not asserted): 1e5 random points on a 200 x 200 mesh."""
+    mesh = create_unit_square(MPI.COMM_SELF, 200, 200, cell_type)
+    x, cells = mesh_arrays(mesh)
+    pts = np.random.default_rng(2).random((100_000, 2))
+    t0 = time.perf_counter()
+    loc = CellLocator(x, cells)
+    t1 = time.perf_counter()
+    r = loc.locate(pts, 0.0)
+    t2 = time.perf_counter()
+    order = np.lexsort((pts[:, 0], np.floor(pts[:, 1] * 200)))  # spatially coherent queries
+    t3 = time.perf_counter()
+    loc.locate(pts[order], 0.0)
+    t4 = time.perf_counter()
+    p3 = np.c_[pts, np.zeros(len(pts))]
+    tree = dolfinx.geometry.BoundingBoxTree(mesh, 2)
+    t5 = time.perf_counter()
+    coll = dolfinx.geometry.compute_colliding_cells(
+        mesh, dolfinx.geometry.compute_collisions(tree, p3), p3
+    )
+    t6 = time.perf_counter()
+    assert np.all(r["cells"] >= 0)
+    assert r["cells"][7] in coll.links(7)
+    print(
+        f"\n[timing] {cell_type.name} 200x200 ({len(cells)} cells): CellLocator build "
+        f"{1e3 * (t1 - t0):.1f} ms, locate 1e5 random points {1e3 * (t2 - t1):.1f} ms "
+        f"({1e5 / (t2 - t1):.2e} points/s), sorted points {1e5 / (t4 - t3):.2e} points/s; "
+        f"dolfinx BoundingBoxTree build {1e3 * (t5 - t4):.1f} ms, collisions "
+        f"{1e3 * (t6 - t5):.1f} ms ({1e5 / (t6 - t5):.2e} points/s)"
+    )
