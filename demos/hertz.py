@@ -12,7 +12,9 @@ Cattaneo-Mindlin: a central stick zone of half-width c = a sqrt(1 - Q/(mu P)).
 The check. metrics.json holds a, p0 and the relative L2 error of p(x) against Hertz *at the
 computed load* (the reaction), the stick half-width against c at the computed Q, the Newton
 residual history and the phase timings. The block (default 40 x 20 mm for a ~ 1 mm) is
-clamped at its bottom; the cylinder top carries the load and is held horizontally.
+clamped at its bottom; the cylinder top is moved rigidly (down, then sideways), so the
+cylinder can neither roll nor slide freely; the approach is iterated until the reaction equals
+the requested load P (0.1 %).
 
 Method: level sets of both bodies on a fine structured grid over the pair's search box, the
 intermediate contact surface (eqs 21-24), closest points (eq 25), penalty + Coulomb return
@@ -25,8 +27,6 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import numpy as np  # noqa: E402
-import ufl  # noqa: E402
-from dolfinx import fem  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 
 from dolfinx_forms import analytic  # noqa: E402
@@ -34,7 +34,7 @@ from dolfinx_forms.cli import DemoParser, bounded, petsc_options  # noqa: E402
 from dolfinx_forms.output import atomic_output, finish, gather_points, plot_tractions  # noqa: E402
 from dolfinx_forms.results import PhaseTimer, new_metrics  # noqa: E402
 from dolfinx_forms.solver import (ContactProblem, ContactSolverError, Dirichlet,  # noqa: E402
-                                  NewtonOptions, Traction, solver_metrics, zone_ends)
+                                  NewtonOptions, solver_metrics, zone_ends)
 from meshes.hertz import hertz_scene  # noqa: E402
 
 DEFAULTS = dict(R=10.0, E=1.0e4, nu=0.3, load=430.0)
@@ -55,6 +55,9 @@ def parse(argv):
     p.add_argument("--mu", type=bounded("--mu", 0, None), default=0.0)
     p.add_argument("--tangential", type=bounded("--tangential", 0, 1, hi_open=True), default=0.0,
                    help="Q/(mu P) of the Cattaneo-Mindlin stage (0: none; needs --mu > 0)")
+    p.add_argument("--band", type=bounded("--band", 0, None, lo_open=True), default=None,
+                   help="largest initial gap covered by the contact surface "
+                        "(default: the gap at x = 1.6 a)")
     p.add_argument("--width", type=bounded("--width", 0, None, lo_open=True), default=None,
                    help="block width (default max(40, 40 a))")
     p.add_argument("--depth", type=bounded("--depth", 0, None, lo_open=True), default=None,
@@ -67,8 +70,8 @@ def parse(argv):
     p.add_argument("--gauss", type=int, choices=range(1, 6), metavar="[1..5]", default=2,
                    help="Gauss points per contact-surface segment")
     p.add_argument("--quads", action="store_true", help="quadrilateral cells")
-    p.add_argument("--steps", type=int, choices=range(1, 101), metavar="[1..100]", default=2,
-                   help="load steps of the normal load")
+    p.add_argument("--steps", type=int, choices=range(1, 101), metavar="[1..100]", default=1,
+                   help="load steps of the first normal approach")
     p.add_argument("--tangential-steps", type=int, choices=range(2, 101), metavar="[2..100]",
                    default=12, help="maximum displacement steps of the tangential stage")
     p.add_argument("--petsc", action="append", default=[], metavar="KEY=VALUE",
@@ -91,8 +94,8 @@ def main(argv=None):
     width = args.width or max(40.0, 40 * a_est)
     depth = args.depth or max(20.0, 20 * a_est)
     params = dict(vars(args), h=h, width=width, depth=depth,
-                  protocol="normal load frictionless (cylinder top held horizontally), then "
-                           "friction on and tangential displacement of the top (monotonic)")
+                  protocol="rigid approach of the cylinder top, frictionless, iterated to the load P; "
+                           "then friction on and monotonic tangential displacement of the top")
     metrics = new_metrics("hertz" if args.tangential == 0 else "mindlin", args.discretization,
                           params)
     timer = PhaseTimer(metrics)
@@ -102,29 +105,18 @@ def main(argv=None):
         scene = hertz_scene(comm, R=args.R, width=width, depth=depth, h=h, zone=zone,
                             quads=args.quads)
     mat = {b.tag: (args.E, args.nu) for b in scene.bodies}
-    P = args.load
     top_x = Dirichlet("cylinder_top", 0, 0.0)
+    top_y = Dirichlet("cylinder_top", 1, 0.0)
     problem = ContactProblem(
-        scene, mat, mu=0.0, eps0=args.eps0, band=zone**2 / (2 * args.R), degree=args.degree,
-        dirichlet=[Dirichlet("block_bottom", None, 0.0), top_x],
-        tractions=[Traction("cylinder_top", ufl.as_vector((0.0, -P / (2 * args.R))))],
+        scene, mat, mu=0.0, eps0=args.eps0, band=args.band or zone**2 / (2 * args.R), degree=args.degree,
+        dirichlet=[Dirichlet("block_bottom", None, 0.0), top_x, top_y],
         petsc_options=args.petsc, timer=timer, newton=NewtonOptions(),
         grid_refine=args.grid_refine, num_gauss=args.gauss)
-
-    # Force control: the cylinder floats until it touches. Start each Newton from a rigid
-    # approach of the cylinder that makes contact (the Hertz indentation scale a^2 / R).
-    cyl_dofs = fem.locate_dofs_topological(problem.V.sub(1), 2, scene.cell_tags.find(2))
-
-    def approach(prob, lam):
-        if prob.lam == 0:
-            a_l, _ = analytic.hertz_line(lam * P, args.R, E_star)
-            prob.u.x.array[cyl_dofs] = -a_l**2 / (2 * args.R)
-
     try:
-        problem.solve(args.steps, label="normal", initial_guess=approach)
+        normal_stage(problem, top_y, args.load, a_est**2 / args.R, args.steps)
         Q = 0.0
         if args.tangential > 0:
-            Q = tangential_stage(problem, top_x, args.mu, args.tangential * args.mu * P,
+            Q = tangential_stage(problem, top_x, args.mu, args.tangential * args.mu * args.load,
                                  args.tangential_steps)
     except ContactSolverError as e:
         sys.stderr.write(f"hertz.py: {e}\n")
@@ -151,12 +143,36 @@ def main(argv=None):
     return 0
 
 
+def move_top(problem, bc, target, steps=1, label="step"):
+    """Ramp a Dirichlet value of the top from its current value to `target`."""
+    start = bc.at(1.0)
+    bc.value = lambda lam: start + lam * (target - start)
+    problem.lam = 0.0  # each move is a stage lam: 0 -> 1 (cut-back safe)
+    problem.solve(steps, label=label)
+
+
+def normal_stage(problem, top_y, P, delta0, steps):
+    """Press the cylinder top down (held horizontally, so it can neither roll nor slide) until
+    the reaction reaches the line load P within 0.1 %. Frictionless, hence path independent:
+    secant iterations on the approach delta, each solve starting from the last one."""
+    history = [(0.0, 0.0)]
+    delta = delta0
+    for k in range(12):
+        move_top(problem, top_y, -delta, steps if k == 0 else 1, label=f"normal delta={delta:.5g}")
+        load = problem.reaction("block_bottom")[1]
+        history.append((delta, load))
+        if abs(load - P) <= 1e-3 * P:
+            return load
+        (d0, p0), (d1, p1) = history[-2], history[-1]
+        delta = d1 + (P - p1) * (d1 - d0) / (p1 - p0)
+    raise ContactSolverError(f"normal stage: load {load:.6g} did not reach {P:.6g} in 12 secant steps")
+
+
 def tangential_stage(problem, top_x, mu, Q_target, max_steps):
     """Move the cylinder top sideways until the tangential force reaches Q_target, approaching
     it from below with secant steps (Q(delta) is concave: slip softens it), so that the
     loading is monotonic as Cattaneo-Mindlin assumes. Returns the reached Q."""
     problem.set_friction(mu)
-    problem.tractions[0].scale = lambda lam: 1.0  # the normal load stays
     delta, Q = 0.0, 0.0
     history = [(0.0, 0.0)]
     for k in range(max_steps):
@@ -165,11 +181,9 @@ def tangential_stage(problem, top_x, mu, Q_target, max_steps):
         else:
             (d0, q0), (d1, q1) = history[-2], history[-1]
             step = (Q_target - q1) * (d1 - d0) / (q1 - q0)
-        top_x.value = (lambda d0, d1: lambda lam: d0 + lam * (d1 - d0))(delta, delta + step)
         delta += step
-        problem.lam = 0.0  # each displacement step is a stage lam: 0 -> 1 (cut-back safe)
-        problem.solve(1, label=f"tangential delta={delta:.4g}")
-        Q = -problem.reaction("cylinder_top")[0]
+        move_top(problem, top_x, delta, label=f"tangential delta={delta:.4g}")
+        Q = problem.reaction("cylinder_top")[0]  # the support drives the top by +delta
         history.append((delta, Q))
         if abs(Q - Q_target) <= 2e-3 * Q_target:
             break
@@ -194,7 +208,10 @@ def evaluate(metrics, pts, reaction, args, E_star, Q):
     metrics["analytic"].update(contact_half_width=float(a), peak_pressure=float(p0))
     if args.tangential > 0:
         c = analytic.mindlin_stick_half_width(a, Q, args.mu, P)
-        sl, sr = zone_ends(x, pts["state"] == 1)
+        # Stick zone: active points that never slipped during the tangential stage (a point
+        # of the slip zone may be momentarily `stick` in a small last load increment)
+        slipped = np.abs(pts["slip"]) > 1e-9 * max(np.abs(pts["slip"]).max(), 1e-300)
+        sl, sr = zone_ends(x, active & ~slipped)
         q = np.abs(pts["p_t"])
         qa = analytic.mindlin_shear(x, a, c, p0, args.mu)
         res.update(tangential_force=float(Q), tangential_ratio=float(Q / (args.mu * P)),

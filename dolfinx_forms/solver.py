@@ -160,6 +160,7 @@ class ContactProblem:
         # Friction history per pair: committed and trial plastic slip (absent when mu == 0)
         self.gtp = [None] * len(self.pairs)
         self.gtp_trial = [None] * len(self.pairs)
+        self.gtp_start = [np.zeros(len(g.weights)) for g in self.pairs]
         self.last = [None] * len(self.pairs)
 
         with self._phase("assembly"):
@@ -212,6 +213,7 @@ class ContactProblem:
                 s = _cpp.assemble_contact(g.quadrature, self.eps_n, self.eps_t, 0.0,
                                           self.u.x.array, np.zeros(0))
                 self.gtp[k] = s["g_t"].copy()
+            self.gtp_start = [g.copy() for g in self.gtp]
         if mu == 0:
             self.gtp = [None] * len(self.pairs)
         self.mu = mu
@@ -347,15 +349,14 @@ class ContactProblem:
 
     # ------------------------------------------------------------------ outputs
     def reaction(self, boundary):
-        """Sum of the internal+contact forces on the dofs of a tagged boundary, [Fx, Fy]."""
+        """Force [Fx, Fy] exerted by the supports on the body at a tagged boundary: the
+        residual K u + r_c - f summed over the boundary's dofs (all components)."""
         self.residual(self.lam, zero_bc=False)
         facets = self.scene.facet_tags.find(self.scene.boundaries[boundary])
         F = np.zeros(2)
-        ext = self._external_force(self.lam)
         for c in range(2):
             dofs = fem.locate_dofs_topological(self.V.sub(c), self.mesh.topology.dim - 1, facets)
-            dofs = dofs[dofs < self.n_owned]
-            F[c] = np.sum(self.R.array[dofs] + ext.array[dofs])
+            F[c] = np.sum(self.R.array[dofs[dofs < self.n_owned]])
         return self.comm.allreduce(F, MPI.SUM)
 
     def contact_points(self):
@@ -364,7 +365,8 @@ class ContactProblem:
         for k, g in enumerate(self.pairs):
             s = _cpp.assemble_contact(g.quadrature, self.eps_n, self.eps_t, self.mu,
                                       self.u.x.array, self.gtp[k] if self.mu > 0 else np.zeros(0))
-            slip = self.gtp[k] if self.mu > 0 else s["g_t"]
+            # plastic slip accumulated since friction was switched on (mu = 0: all of g_t)
+            slip = self.gtp[k] - self.gtp_start[k] if self.mu > 0 else s["g_t"]
             out.append(dict(x=g.points[:, 0], y=g.points[:, 1], w=g.weights, normals=g.normals,
                             p_n=-s["tau_n"], p_t=s["tau_t"], gap_n=s["g_n"], slip=slip,
                             state=s["state"]))
