@@ -282,9 +282,12 @@ class ContactProblem:
                 dnorm, unorm = self.du.vector.norm(), self.u.vector.norm()
                 if dnorm <= opts.stol * max(unorm, 1e-300) and r <= np.sqrt(opts.rtol) * r0:
                     return True, residuals, ""
-            # An active set seen before without a lower residual: Newton is cycling
+            # An active set seen before without a lower residual: Newton is cycling. The
+            # states live on the contact rank only: the decision must be collective.
             sig = self._active_signature()
-            if sig in seen and r >= 0.999 * seen[sig]:
+            cycling = self.comm.allreduce(bool(sig) and sig in seen and r >= 0.999 * seen[sig],
+                                          op=MPI.LOR)
+            if cycling:
                 return False, residuals, f"active set cycles (iteration {it})"
             seen[sig] = min(r, seen.get(sig, np.inf))
             if it == opts.max_iterations:

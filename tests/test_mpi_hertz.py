@@ -1,0 +1,44 @@
+"""Hertz contact on 2 MPI ranks gives the reaction of 1 rank (run under mpirun -n 2).
+
+The scene partitioner puts every cell of the contact search box on rank 0, so the contact
+points and both bodies' cells around them are local there; the other rank only assembles
+bulk elasticity. The reaction of the distributed problem must equal the serial one (each rank
+also solves the same problem on COMM_SELF) to 1e-8 relative.
+"""
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from dolfinx_forms.solver import ContactProblem, Dirichlet
+from meshes.hertz import hertz_scene
+
+
+def reaction(comm, mu):
+    scene = hertz_scene(comm, R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.6)
+    mat = {b.tag: (1e4, 0.3) for b in scene.bodies}
+    top_x = Dirichlet("cylinder_top", 0, 0.0)
+    top_y = Dirichlet("cylinder_top", 1, lambda lam: -0.15 * lam)
+    p = ContactProblem(scene, mat, mu=0.0, eps0=0.5, band=0.13,
+                       dirichlet=[Dirichlet("block_bottom", None, 0.0), top_x, top_y],
+                       log=lambda *a: None)
+    p.solve(2)
+    if mu > 0:  # a frictional tangential step: history and stick/slip in parallel too
+        p.set_friction(mu)
+        top_y.value = -0.15
+        top_x.value = lambda lam: 0.01 * lam
+        p.lam = 0.0
+        p.solve(2)
+    return p.reaction("block_bottom"), p.num_dofs
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("mu", [0.0, 0.3])
+def test_two_ranks_match_one(mu):
+    world = MPI.COMM_WORLD
+    assert world.size == 2, "run under mpirun -n 2"
+    r2, n2 = reaction(world, mu)
+    r1, n1 = reaction(MPI.COMM_SELF, mu)
+    assert n1 == n2
+    assert abs(r2[1]) > 100
+    np.testing.assert_allclose(r2, r1, rtol=1e-8, atol=1e-8 * abs(r1[1]))
