@@ -181,6 +181,9 @@ class ContactProblem:
             self.K.assemble()
             self.J = self.K.duplicate(copy=False)
             self.J.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
+            # zeroRows must not shrink the pattern: MatCopy(SAME_NONZERO_PATTERN) each
+            # iteration and the reuse of the symbolic LU factorisation depend on it
+            self.J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
             self.R = self.K.createVecLeft()
             self.Ku = self.K.createVecLeft()
             self.du = fem.Function(self.V)
