@@ -161,7 +161,10 @@ class ContactProblem:
         self.gtp = [None] * len(self.pairs)
         self.gtp_trial = [None] * len(self.pairs)
         self.gtp_start = [np.zeros(len(g.weights)) for g in self.pairs]
+        if self.mu > 0:  # friction from the start: zero plastic slip in the reference state
+            self.gtp = [np.zeros(len(g.weights)) for g in self.pairs]
         self.last = [None] * len(self.pairs)
+        self.committed = [None] * len(self.pairs)  # point states of the last accepted step
 
         with self._phase("assembly"):
             # Sparsity: mesh couplings + contact coupling blocks; the pattern never changes.
@@ -310,6 +313,9 @@ class ContactProblem:
         return False, residuals, f"no convergence in {opts.max_iterations} iterations"
 
     def _commit(self, lam):
+        # Keep the accepted step's point states: re-evaluating them with the committed slip
+        # would put the slipped points exactly on the cone, where stick/slip is a coin toss.
+        self.committed = [dict(s) for s in self.last]
         self.u_committed[:] = self.u.x.array
         if self.mu > 0:
             self.gtp = [g.copy() for g in self.gtp_trial]
@@ -369,8 +375,11 @@ class ContactProblem:
         """Per-point records of all pairs on this rank (reference configuration)."""
         out = []
         for k, g in enumerate(self.pairs):
-            s = _cpp.assemble_contact(g.quadrature, self.eps_n, self.eps_t, self.mu,
-                                      self.u.x.array, self.gtp[k] if self.mu > 0 else np.zeros(0))
+            s = self.committed[k]
+            if s is None:  # nothing solved yet
+                s = _cpp.assemble_contact(g.quadrature, self.eps_n, self.eps_t, self.mu,
+                                          self.u.x.array,
+                                          self.gtp[k] if self.mu > 0 else np.zeros(0))
             # plastic slip accumulated since friction was switched on (mu = 0: all of g_t)
             slip = self.gtp[k] - self.gtp_start[k] if self.mu > 0 else s["g_t"]
             out.append(dict(x=g.points[:, 0], y=g.points[:, 1], w=g.weights, normals=g.normals,

@@ -17,16 +17,16 @@ namespace contact {
 /// geometry does not change during Newton, only u does (eqs 27-30).
 /// Dof indices are *block* (node) indices into a local vector with block size 2.
 struct ContactQuadrature {
-  int nodes_i = 0;                   ///< basis functions per cell of body i
-  int nodes_j = 0;                   ///< basis functions per cell of body j
-  std::vector<double> weights;       ///< (nq,) length measure
-  std::vector<double> normals;       ///< (nq, 2)
-  std::vector<double> tangents;      ///< (nq, 2)
-  std::vector<double> g_n0;          ///< (nq,)
-  std::vector<std::int32_t> dofs_i;  ///< (nq, nodes_i) block dofs of the cell containing P_i
-  std::vector<std::int32_t> dofs_j;  ///< (nq, nodes_j)
-  std::vector<double> basis_i;       ///< (nq, nodes_i) basis values at P_i
-  std::vector<double> basis_j;       ///< (nq, nodes_j)
+  int nodes_i = 0;                  ///< basis functions per cell of body i
+  int nodes_j = 0;                  ///< basis functions per cell of body j
+  std::vector<double> weights;      ///< (nq,) length measure
+  std::vector<double> normals;      ///< (nq, 2)
+  std::vector<double> tangents;     ///< (nq, 2)
+  std::vector<double> g_n0;         ///< (nq,)
+  std::vector<std::int32_t> dofs_i; ///< (nq, nodes_i) block dofs of the cell containing P_i
+  std::vector<std::int32_t> dofs_j; ///< (nq, nodes_j)
+  std::vector<double> basis_i;      ///< (nq, nodes_i) basis values at P_i
+  std::vector<double> basis_j;      ///< (nq, nodes_j)
 
   /// @brief Number of quadrature points.
   std::size_t size() const { return weights.size(); }
@@ -37,10 +37,10 @@ struct ContactQuadrature {
 
 /// @brief Traction state of every quadrature point after an evaluation.
 struct ContactPointState {
-  std::vector<double> g_n, g_t;        ///< gaps (eqs 27, 30)
-  std::vector<double> tau_n, tau_t;    ///< tractions (compression negative)
-  std::vector<double> gtp_trial;       ///< plastic slip after this evaluation
-  std::vector<ContactState> state;     ///< open / stick / slip
+  std::vector<double> g_n, g_t;     ///< gaps (eqs 27, 30)
+  std::vector<double> tau_n, tau_t; ///< tractions (compression negative)
+  std::vector<double> gtp_trial;    ///< plastic slip after this evaluation
+  std::vector<ContactState> state;  ///< open / stick / slip
 };
 
 /// @brief Callback receiving one point's element matrix: block dofs (nodes_i + nodes_j) and the

@@ -18,8 +18,8 @@ using contact::python::to_numpy;
 using iarray = py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>;
 
 namespace {
-template <typename T> std::vector<T> copy_of(const py::array_t<T, py::array::c_style |
-                                                                       py::array::forcecast>& a) {
+template <typename T>
+std::vector<T> copy_of(const py::array_t<T, py::array::c_style | py::array::forcecast>& a) {
   return std::vector<T>(a.data(), a.data() + a.size());
 }
 
@@ -60,7 +60,8 @@ void bind_assembly(py::module_& m) {
       .def("__len__", &ContactQuadrature::size)
       .def_property_readonly("g_n0",
                              [](const ContactQuadrature& q) {
-                               return to_numpy(std::vector<double>(q.g_n0), {py::ssize_t(q.size())});
+                               return to_numpy(std::vector<double>(q.g_n0),
+                                               {py::ssize_t(q.size())});
                              })
       .def(
           "coupling_dofs",
@@ -123,9 +124,9 @@ void bind_assembly(py::module_& m) {
         }
         const auto mode = finite_difference ? contact::TangentMode::finite_difference
                                             : contact::TangentMode::exact;
-        contact::ContactPointState s = contact::assemble_contact(
-            q, contact::CoulombPenalty{eps_n, eps_t, mu}, as_span(u, "u"),
-            as_span(gtp_old, "gtp_old"), bs, insert, mode, fd_step);
+        contact::ContactPointState s =
+            contact::assemble_contact(q, contact::CoulombPenalty{eps_n, eps_t, mu}, as_span(u, "u"),
+                                      as_span(gtp_old, "gtp_old"), bs, insert, mode, fd_step);
         const auto nq = py::ssize_t(q.size());
         std::vector<std::int8_t> st(s.state.size());
         for (std::size_t p = 0; p < st.size(); ++p)

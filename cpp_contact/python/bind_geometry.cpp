@@ -191,9 +191,9 @@ void bind_geometry(py::module_& m) {
       "closest_point_projection",
       [](const Shape& shape, const carray& pts, double length_scale, double rtol,
          int max_iterations, double grad_tol) {
-        ProjectionResult r = closest_point_projection(
-            shape, as_span(pts, "points", 2), length_scale,
-            ProjectionOptions{rtol, max_iterations, grad_tol});
+        ProjectionResult r =
+            closest_point_projection(shape, as_span(pts, "points", 2), length_scale,
+                                     ProjectionOptions{rtol, max_iterations, grad_tol});
         const auto n = py::ssize_t(r.iterations.size());
         std::vector<std::int8_t> st(r.status.size());
         py::array_t<bool> conv(n);
