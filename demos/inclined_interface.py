@@ -173,7 +173,7 @@ def main(argv=None):
     except ContactSolverError as e:
         sys.stderr.write(f"inclined_interface.py: {e}\n")
         return 1
-    g_t = report_step_states(problem)
+    g_t = tangential_jump(problem)
 
     reaction = problem.reaction("upper_top")
     pts = gather_points(problem)
@@ -219,28 +219,11 @@ def set_linear_values(problem, cond, slope, offset):
     cond.value = lambda lam: lam * vals
 
 
-def report_step_states(problem):
-    """Report the contact state of the last converged load step in tractions.csv, and return
-    (x, g_t): the total tangential jump at this rank's contact points.
-
-    After a step is committed, ContactProblem.contact_points() re-runs the return mapping from
-    the *new* plastic slip, so a point that slipped in the step lies exactly on the slip surface
-    (phi_tr = 0 up to round-off) and is labelled stick or slip at random. The state of the
-    converged Newton iterate (relative to the slip committed before the step) is the meaningful
-    one: "slip" = slipped during the last load step."""
-    step_states = [s["state"].copy() for s in problem.last]
-    records = problem.contact_points
-
-    def contact_points():
-        out = records()
-        for rec, st in zip(out, step_states):
-            rec["state"] = st
-        return out
-
-    problem.contact_points = contact_points
+def tangential_jump(problem):
+    """(x, g_t): the total tangential jump at this rank's contact points, last accepted step."""
     cat = lambda a: np.concatenate(a) if a else np.zeros(0)  # noqa: E731
     return (cat([g.points[:, 0] for g in problem.pairs]),
-            cat([s["g_t"].copy() for s in problem.last]))
+            cat([s["g_t"] for s in problem.committed]))
 
 
 def evaluate(metrics, pts, g_t, reaction, ref, args):

@@ -135,7 +135,6 @@ def main(argv=None):
     except ContactSolverError as e:
         sys.stderr.write(f"two_blocks.py: {e}\n")
         return 1
-    report_step_states(problem)
 
     reaction = problem.reaction("upper_top")
     pts = gather_points(problem)
@@ -166,26 +165,6 @@ def main(argv=None):
               f"iterations per step")
         print(f"results in {Path(args.out).resolve()}")
     return 0
-
-
-def report_step_states(problem):
-    """Report the contact state of the last converged load step in tractions.csv.
-
-    After a step is committed, ContactProblem.contact_points() re-runs the return mapping from
-    the *new* plastic slip, so a point that slipped in the step lies exactly on the slip surface
-    (phi_tr = 0 up to round-off) and is labelled stick or slip at random. The state of the
-    converged Newton iterate (relative to the slip committed before the step) is the meaningful
-    one: "slip" = slipped during the last load step."""
-    step_states = [s["state"].copy() for s in problem.last]
-    records = problem.contact_points
-
-    def contact_points():
-        out = records()
-        for rec, st in zip(out, step_states):
-            rec["state"] = st
-        return out
-
-    problem.contact_points = contact_points
 
 
 def sigma_x_line(problem, y, xs):

@@ -1,49 +1,15 @@
-"""Demo outputs: atomic result folders in parallel, tractions.csv, XDMF, traction plots."""
+"""Demo outputs: tractions.csv, XDMF, traction plots (atomic folders: results.py)."""
 
 import csv
-import os
-import shutil
-import tempfile
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
-from mpi4py import MPI
 
+from .results import atomic_output_dir as atomic_output  # noqa: F401 (demos use it)
 from .results import write_metrics
 from .solver import STATE_NAMES
 
 TRACTION_COLUMNS = ("x", "y", "p_n", "p_t", "gap_n", "slip", "state")
-
-
-@contextmanager
-def atomic_output(out, comm=MPI.COMM_WORLD):
-    """A temporary folder beside `out` shared by all ranks; it replaces `out` in one rename
-    on success and is removed on any failure (no half-written results)."""
-    out = Path(out).resolve()
-    tmp = None
-    if comm.rank == 0:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent)
-    tmp = Path(comm.bcast(tmp, root=0))
-    ok = False
-    try:
-        yield tmp
-        ok = True
-    finally:
-        ok = comm.allreduce(ok, op=MPI.LAND)
-        if comm.rank == 0:
-            if ok:
-                if out.exists():
-                    old = out.with_name(f".{out.name}.old.{os.getpid()}")
-                    os.replace(out, old)
-                    os.replace(tmp, out)
-                    shutil.rmtree(old, ignore_errors=True)
-                else:
-                    os.replace(tmp, out)
-            else:
-                shutil.rmtree(tmp, ignore_errors=True)
-        comm.barrier()
 
 
 def gather_points(problem):

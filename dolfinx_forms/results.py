@@ -66,26 +66,37 @@ def _check_finite(obj, path="metrics"):
 
 
 @contextmanager
-def atomic_output_dir(out):
-    """Yield a temporary folder beside `out`; on success it replaces `out` in one rename.
+def atomic_output_dir(out, comm=None):
+    """Yield a temporary folder beside `out`, shared by all ranks of `comm` (default
+    COMM_WORLD); it replaces `out` in one rename when every rank succeeded and is removed on
+    any failure, leaving `out` untouched (no half-written results)."""
+    from mpi4py import MPI
 
-    On any exception the temporary folder is removed and `out` is left untouched.
-    """
+    comm = MPI.COMM_WORLD if comm is None else comm
     out = Path(out).resolve()
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    tmp = None
+    if comm.rank == 0:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent)
+    tmp = Path(comm.bcast(tmp, root=0))
+    ok = False
     try:
         yield tmp
-        if out.exists():
-            old = out.with_name(f".{out.name}.old.{os.getpid()}")
-            os.replace(out, old)
-            os.replace(tmp, out)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
+        ok = True
+    finally:
+        ok = comm.allreduce(ok, op=MPI.LAND)
+        if comm.rank == 0:
+            if ok:
+                if out.exists():
+                    old = out.with_name(f".{out.name}.old.{os.getpid()}")
+                    os.replace(out, old)
+                    os.replace(tmp, out)
+                    shutil.rmtree(old, ignore_errors=True)
+                else:
+                    os.replace(tmp, out)
+            else:
+                shutil.rmtree(tmp, ignore_errors=True)
+        comm.barrier()
 
 
 def write_metrics(folder, metrics):

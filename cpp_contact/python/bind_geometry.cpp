@@ -16,6 +16,26 @@ using contact::python::as_span;
 using contact::python::carray;
 using contact::python::to_numpy;
 
+namespace {
+/// The dict both closest_point_projection overloads return.
+py::dict projection_dict(contact::ProjectionResult&& r) {
+  using contact::ProjectionStatus;
+  const auto n = py::ssize_t(r.iterations.size());
+  std::vector<std::int8_t> st(r.status.size());
+  py::array_t<bool> conv(n);
+  for (py::ssize_t p = 0; p < n; ++p) {
+    st[p] = std::int8_t(r.status[p]);
+    conv.mutable_at(p) = r.status[p] == ProjectionStatus::converged;
+  }
+  py::dict d;
+  d["points"] = to_numpy(std::move(r.points), {n, 2});
+  d["status"] = to_numpy(std::move(st), {n});
+  d["iterations"] = to_numpy(std::move(r.iterations), {n});
+  d["converged"] = conv;
+  return d;
+}
+} // namespace
+
 void bind_geometry(py::module_& m) {
   py::class_<StructuredGrid>(m, "StructuredGrid",
                              "Tensor-product 2D grid, uniform or graded; nodes x-fastest")
@@ -169,19 +189,7 @@ void bind_geometry(py::module_& m) {
       [](const LevelSet& phi, const carray& pts, double rtol, int max_iterations, double grad_tol) {
         ProjectionResult r = closest_point_projection(
             phi, as_span(pts, "points", 2), ProjectionOptions{rtol, max_iterations, grad_tol});
-        const auto n = py::ssize_t(r.iterations.size());
-        std::vector<std::int8_t> st(r.status.size());
-        for (std::size_t p = 0; p < st.size(); ++p)
-          st[p] = std::int8_t(r.status[p]);
-        py::array_t<bool> conv(n);
-        for (py::ssize_t p = 0; p < n; ++p)
-          conv.mutable_at(p) = r.status[p] == ProjectionStatus::converged;
-        py::dict d;
-        d["points"] = to_numpy(std::move(r.points), {n, 2});
-        d["status"] = to_numpy(std::move(st), {n});
-        d["iterations"] = to_numpy(std::move(r.iterations), {n});
-        d["converged"] = conv;
-        return d;
+        return projection_dict(std::move(r));
       },
       py::arg("phi"), py::arg("points"), py::arg("rtol") = 1e-10, py::arg("max_iterations") = 50,
       py::arg("grad_tol") = 1e-8,
@@ -194,19 +202,7 @@ void bind_geometry(py::module_& m) {
         ProjectionResult r =
             closest_point_projection(shape, as_span(pts, "points", 2), length_scale,
                                      ProjectionOptions{rtol, max_iterations, grad_tol});
-        const auto n = py::ssize_t(r.iterations.size());
-        std::vector<std::int8_t> st(r.status.size());
-        py::array_t<bool> conv(n);
-        for (py::ssize_t p = 0; p < n; ++p) {
-          st[p] = std::int8_t(r.status[p]);
-          conv.mutable_at(p) = r.status[p] == ProjectionStatus::converged;
-        }
-        py::dict d;
-        d["points"] = to_numpy(std::move(r.points), {n, 2});
-        d["status"] = to_numpy(std::move(st), {n});
-        d["iterations"] = to_numpy(std::move(r.iterations), {n});
-        d["converged"] = conv;
-        return d;
+        return projection_dict(std::move(r));
       },
       py::arg("shape"), py::arg("points"), py::arg("length_scale"), py::arg("rtol") = 1e-10,
       py::arg("max_iterations") = 20, py::arg("grad_tol") = 1e-8,
