@@ -11,6 +11,10 @@ problem is p = E' d / (H + E' eps_n), E' = E/(1-nu^2), which tends to 0.01098901
 The check. Linear fields are reproduced exactly by the discretisation, so with the interface
 on mesh lines the contact pressure must be uniform and equal to the penalised value to
 round-off; metrics.json reports the spread, the shear, and both analytic values.
+On the cut path (--discretization cut) both blocks are level sets on one uniform grid of
+n = 1/h cells over the height and the interface y = --interface (default 0.5 + 0.3 h) cuts a
+row of cells: the exact solution is still linear in each body, so the pressure stays uniform to
+round-off for any cut height.
 """
 
 import sys
@@ -22,18 +26,23 @@ import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 
 from dolfinx_forms import analytic  # noqa: E402
-from dolfinx_forms.cli import DemoParser, bounded, petsc_options  # noqa: E402
+from dolfinx_forms.cli import (DemoParser, add_discretization, bounded,  # noqa: E402
+                               check_discretization, petsc_options)
 from dolfinx_forms.output import atomic_output, finish, gather_points, plot_tractions  # noqa: E402
 from dolfinx_forms.results import PhaseTimer, new_metrics  # noqa: E402
 from dolfinx_forms.solver import (ContactProblem, ContactSolverError, Dirichlet,  # noqa: E402
                                   solver_metrics)
+from meshes.cut import patch_cut_scene  # noqa: E402
 from meshes.patch import patch_scene  # noqa: E402
 
 
 def parse(argv):
     p = DemoParser(prog="patch_test.py", description=__doc__.split("\n\n")[0])
     p.add_argument("--out", default="results/patch_test")
-    p.add_argument("--discretization", choices=["conforming", "cut"], default="conforming")
+    add_discretization(p)
+    p.add_argument("--interface", type=bounded("--interface", 0, 1, lo_open=True, hi_open=True),
+                   default=None, help="cut path: height of the interface, off the grid lines "
+                                      "(default 0.5 + 0.3 h)")
     p.add_argument("--h", type=bounded("--h", 0, 0.5, lo_open=True), default=0.125,
                    help="mesh size (cells of the lower block: 1/h x 0.5/h)")
     p.add_argument("--E", type=bounded("--E", 0, None, lo_open=True), default=1.0)
@@ -48,13 +57,23 @@ def parse(argv):
     p.add_argument("--triangles", action="store_true")
     p.add_argument("--petsc", action="append", default=[], metavar="KEY=VALUE")
     a = p.parse_args(argv)
-    if a.discretization == "cut":
-        p.error("--discretization: 'cut' is not available yet (cut-cell path: issue 4); use conforming")
+    check_discretization(p, a)
     nx = round(1.0 / a.h)
     if abs(nx * a.h - 1.0) > 1e-12 or nx % 1:
         p.error(f"--h: must be 1/n for an integer n so that the interface lies on mesh lines, got {a.h}")
     if a.upper_cells is not None and not 1 <= a.upper_cells <= 1000:
         p.error("--upper-cells: must be in [1, 1000]")
+    if a.discretization == "conforming" and a.interface is not None:
+        p.error("--interface: only for --discretization cut (the gmsh blocks meet at 0.5)")
+    if a.discretization == "cut":
+        if a.interface is None:
+            a.interface = 0.5 + 0.3 * a.h
+        k = a.interface / a.h
+        if abs(k - round(k)) < 1e-9:
+            p.error(f"--interface: must not lie on a grid line (multiples of h = {a.h}), "
+                    f"got {a.interface}")
+        if a.upper_cells is not None:
+            p.error("--upper-cells: only for --discretization conforming")
     a.petsc = petsc_options(p, a.petsc)
     return a
 
@@ -66,12 +85,16 @@ def main(argv=None):
     timer = PhaseTimer(metrics)
     nx = round(1.0 / args.h)
     with timer.phase("mesh"):
-        scene = patch_scene(comm, nx=nx, ny=max(1, nx // 2), quads=not args.triangles,
-                            nx_upper=args.upper_cells)
+        if args.discretization == "cut":
+            scene = patch_cut_scene(comm, n=nx, interface=args.interface)
+        else:
+            scene = patch_scene(comm, nx=nx, ny=max(1, nx // 2), quads=not args.triangles,
+                                nx_upper=args.upper_cells)
     d = args.displacement
     problem = ContactProblem(
         scene, {b.tag: (args.E, args.nu) for b in scene.bodies}, mu=args.mu, eps0=args.eps0,
         band=0.5 * args.h, degree=args.degree, petsc_options=args.petsc, timer=timer,
+        ghost_penalty=args.ghost_penalty,
         dirichlet=[Dirichlet("lower_bottom", 1, 0.0),
                    Dirichlet("upper_top", 1, lambda lam: -d * lam),
                    Dirichlet(lambda x: np.isclose(x[0], 0) & np.isclose(x[1], 0), 0, 0.0),

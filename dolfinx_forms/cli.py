@@ -50,3 +50,17 @@ def petsc_options(parser, items):
             parser.error(f"--petsc: expected KEY=VALUE, got {item!r}")
         opts[key] = value
     return opts
+
+
+def add_discretization(parser):
+    """--discretization and the cut path's --ghost-penalty (shared by every demo)."""
+    parser.add_argument("--discretization", choices=["conforming", "cut"], default="conforming",
+                        help="body-fitted gmsh meshes, or level sets cutting a structured grid")
+    parser.add_argument("--ghost-penalty", type=bounded("--ghost-penalty", 0, None), default=0.1,
+                        help="cut path: ghost-penalty factor on the faces of cut cells (0: off)")
+
+
+def check_discretization(parser, args):
+    """The cut path is vector Q1 on quadrilaterals."""
+    if args.discretization == "cut" and getattr(args, "degree", 1) != 1:
+        parser.error(f"--degree: the cut discretization supports degree 1 only, got {args.degree}")

@@ -88,12 +88,14 @@ class ContactProblem:
 
     materials: {body tag: (E, nu)}; mu: friction coefficient (0: frictionless, no friction
     work); eps0: penalty factor of eq 51, eps_n = eps_t = eps0 h / E_mean; band: largest
-    initial gap that Gamma_c covers (a length); degree: Lagrange degree (1 or 2).
+    initial gap that Gamma_c covers (a length); degree: Lagrange degree (1 or 2; 1 on a cut
+    scene). A scene with `cut` data (meshes.cut) gets the cut-cell forms of `cut.CutForms`
+    with ghost penalty `ghost_penalty` (0: none).
     """
 
     def __init__(self, scene, materials, *, mu=0.0, eps0=1.0, band=None, degree=1,
                  dirichlet=(), tractions=(), newton=None, petsc_options=None, grid_refine=4,
-                 num_gauss=2, timer=None, contact_rank=0, log=print):
+                 num_gauss=2, timer=None, contact_rank=0, ghost_penalty=0.1, log=print):
         self.scene, self.mesh = scene, scene.mesh
         self.comm = self.mesh.comm
         self.mu = float(mu)
@@ -110,19 +112,27 @@ class ContactProblem:
             dx = ufl.Measure("dx", domain=self.mesh, subdomain_data=scene.cell_tags)
             ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=scene.facet_tags)
             eps = lambda w: ufl.sym(ufl.grad(w))  # noqa: E731
-            a = 0
-            self.E = {}
-            for tag, (E, nu) in materials.items():
-                m, lmb = plane_strain(E, nu)
-                self.E[tag] = E
-                sig = 2 * m * eps(du) + lmb * ufl.tr(eps(du)) * ufl.Identity(2)
-                a += ufl.inner(sig, eps(v)) * dx(tag)
+            self.E = {tag: E for tag, (E, _) in materials.items()}
             self.materials = dict(materials)
-            self.a_form = fem.form(a)
+            self.cut = None
+            if getattr(scene, "cut", None) is not None:  # cut cells: C++ kernels in the Form
+                from .cut import CutForms
+
+                self.cut = CutForms(self.V, scene, materials, ghost_penalty=ghost_penalty)
+                self.a_form = self.cut.a
+            else:
+                a = 0
+                for tag, (E, nu) in materials.items():
+                    m, lmb = plane_strain(E, nu)
+                    sig = 2 * m * eps(du) + lmb * ufl.tr(eps(du)) * ufl.Identity(2)
+                    a += ufl.inner(sig, eps(v)) * dx(tag)
+                self.a_form = fem.form(a)
             self.tractions = list(tractions)
             self.f_vectors = []
             for t in self.tractions:
-                L = fem.form(ufl.inner(t.traction, v) * ds(scene.boundaries[t.boundary]))
+                tag = scene.boundaries[t.boundary]
+                L = (self.cut.traction_form(t.traction, tag) if self.cut is not None
+                     else fem.form(ufl.inner(t.traction, v) * ds(tag)))
                 self.f_vectors.append(fem.petsc.assemble_vector(L))
                 self.f_vectors[-1].ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
 
@@ -173,6 +183,8 @@ class ContactProblem:
                 {_dcpp.fem.IntegralType.cell})
             for g in self.pairs:
                 _cpp.insert_coupling(pattern, g.quadrature)
+            if self.cut is not None:
+                self.cut.insert_ghost_couplings(pattern)
             pattern.assemble()
             self.K = _dcpp.la.petsc.create_matrix(self.comm, pattern)
             self.K.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import contextlib
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import dolfinx
 import dolfinx.cpp
@@ -29,8 +30,12 @@ import dolfinx.io.gmshio
 import dolfinx.mesh
 import numpy as np
 
+if TYPE_CHECKING:
+    from .cut import CutData
+
 __all__ = ["Body", "Scene", "scene_from_gmsh", "gmsh_model", "contact_partitioner", "cell_bboxes",
-           "add_polygon", "on_box_side", "summary", "cell_edges", "max_edge_in_box", "extract_gmsh"]
+           "add_polygon", "on_box_side", "summary", "cell_edges", "max_edge_in_box", "extract_gmsh",
+           "tag_boundaries"]
 
 
 @dataclass
@@ -51,6 +56,7 @@ class Scene:
     pairs: list[tuple[int, int]]  # contact pairs as indices into bodies (i, j)
     h_contact: float  # mesh size at the contact
     cell_type: str  # "triangle" or "quadrilateral"
+    cut: CutData | None = None  # structured cut-cell scenes (meshes/cut.py) only
 
 
 # --------------------------------------------------------------------------- gmsh session
@@ -265,6 +271,34 @@ def extract_gmsh(gmsh):
     return gtype, np.ascontiguousarray(x), np.ascontiguousarray(cells[:, perm]).astype(np.int64)
 
 
+def tag_boundaries(mesh, cell_values, bodies, boundary_markers):
+    """(facet_tags named "boundaries", boundaries name -> tag value) from boundary_markers
+    (name -> (tag, predicate[, body]), see :func:`scene_from_gmsh`); cell_values: body tag of
+    every local cell (owned and ghost), used by the markers restricted to one body."""
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    f2c = mesh.topology.connectivity(tdim - 1, tdim)
+    fmap = mesh.topology.index_map(tdim - 1)
+    nfacets = fmap.size_local + fmap.num_ghosts
+    fvalues = np.zeros(nfacets, np.int32)
+    names = [b.name for b in bodies]
+    boundaries = {}
+    for name, spec in boundary_markers.items():
+        tag, pred = spec[0], spec[1]
+        boundaries[name] = int(tag)
+        facets = dolfinx.mesh.locate_entities_boundary(mesh, tdim - 1, pred)
+        if len(spec) > 2 and len(facets):
+            body = spec[2] if not isinstance(spec[2], str) else names.index(spec[2])
+            first_cell = f2c.array[f2c.offsets[facets]]
+            facets = facets[cell_values[first_cell] == bodies[body].tag]
+        facets = facets[fvalues[facets] == 0]
+        fvalues[facets] = tag
+    marked = np.flatnonzero(fvalues).astype(np.int32)
+    facet_tags = dolfinx.mesh.meshtags(mesh, tdim - 1, marked, fvalues[marked])
+    facet_tags.name = "boundaries"
+    return facet_tags, boundaries
+
+
 def scene_from_gmsh(comm, bodies, boundary_markers, pairs, h_contact, contact_box=None,
                     ghost_mode=dolfinx.mesh.GhostMode.shared_facet) -> Scene:
     """Collective: build the Scene from the meshed gmsh model on rank 0 (first-order 2D cells).
@@ -309,27 +343,7 @@ def scene_from_gmsh(comm, bodies, boundary_markers, pairs, h_contact, contact_bo
     cell_tags = dolfinx.mesh.meshtags(mesh, tdim, np.arange(ncells, dtype=np.int32), cvalues)
     cell_tags.name = "bodies"
 
-    # facet tags
-    mesh.topology.create_connectivity(tdim - 1, tdim)
-    f2c = mesh.topology.connectivity(tdim - 1, tdim)
-    fmap = mesh.topology.index_map(tdim - 1)
-    nfacets = fmap.size_local + fmap.num_ghosts
-    fvalues = np.zeros(nfacets, np.int32)
-    names = [b.name for b in bodies]
-    boundaries = {}
-    for name, spec in boundary_markers.items():
-        tag, pred = spec[0], spec[1]
-        boundaries[name] = int(tag)
-        facets = dolfinx.mesh.locate_entities_boundary(mesh, tdim - 1, pred)
-        if len(spec) > 2 and len(facets):
-            body = spec[2] if not isinstance(spec[2], str) else names.index(spec[2])
-            first_cell = f2c.array[f2c.offsets[facets]]
-            facets = facets[cvalues[first_cell] == bodies[body].tag]
-        facets = facets[fvalues[facets] == 0]
-        fvalues[facets] = tag
-    marked = np.flatnonzero(fvalues).astype(np.int32)
-    facet_tags = dolfinx.mesh.meshtags(mesh, tdim - 1, marked, fvalues[marked])
-    facet_tags.name = "boundaries"
+    facet_tags, boundaries = tag_boundaries(mesh, cvalues, bodies, boundary_markers)
 
     return Scene(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, boundaries=boundaries,
                  bodies=list(bodies), pairs=[tuple(p) for p in pairs], h_contact=float(h_contact),

@@ -1,8 +1,9 @@
-"""Hertz, Cattaneo-Mindlin and the patch test on body-fitted meshes (coarse settings).
+"""Hertz, Cattaneo-Mindlin and the patch test, body-fitted and cut (coarse settings).
 
-Tolerances: Hertz at h = a/20 (P1) has a ~1 % discretisation + penalty error in a and p0
-(eps0 = 0.5, eq 51) and ~1.2 % in p(x): the acceptance bounds are 2 % and 3 %. The patch test
-reproduces the penalised exact solution p = E' d / (H + E' eps_n) to round-off.
+Tolerances: Hertz at h = a/20 (P1 triangles, or Q1 on the cut grid) has a ~1 % discretisation
++ penalty error in a and p0 (eps0 = 0.5, eq 51) and 1.2 % (gmsh) / 1.7 % (cut) in p(x): the
+acceptance bounds are 2 % and 3 %. The patch test reproduces the penalised exact solution
+p = E' d / (H + E' eps_n) to round-off on both paths, for any height of the cut interface.
 """
 
 import json
@@ -26,12 +27,40 @@ def metrics(out):
     return json.loads((Path(out) / "metrics.json").read_text())
 
 
-@pytest.fixture(scope="module")
-def hertz(tmp_path_factory):
-    out = tmp_path_factory.mktemp("hertz") / "res"
-    r = run("hertz.py", out)
-    assert r.returncode == 0, r.stderr
-    return out
+_RUNS = {}  # discretization -> output folder of the default Hertz run
+
+
+def hertz_run(tmp_path_factory, disc):
+    if disc not in _RUNS:
+        out = tmp_path_factory.mktemp("hertz") / disc
+        r = run("hertz.py", out, "--discretization", disc)
+        assert r.returncode == 0, r.stderr
+        _RUNS[disc] = out
+    return _RUNS[disc]
+
+
+@pytest.fixture(scope="module", params=["conforming", "cut"])
+def hertz(tmp_path_factory, request):
+    return hertz_run(tmp_path_factory, request.param)
+
+
+def test_hertz_cut_matches_gmsh(hertz, tmp_path_factory):
+    """Cut vs body-fitted p(x) at equal h, at the same contact points (Gamma_c depends only
+    on the bounding boxes and h). Pointwise the two differ by the penalty's element-scale
+    ripple (1.8 %; gmsh triangles vs gmsh quads differ by as much): averaged over one cell
+    width the profiles agree to 0.5 %, asserted at 1 %."""
+    if hertz.name != "cut":
+        pytest.skip("compares the cut run with the conforming one")
+    from dolfinx_forms.output import window_average
+
+    cut, gmsh = (np.genfromtxt(d / "tractions.csv", delimiter=",", names=True, dtype=None,
+                               encoding=None)
+                 for d in (hertz, hertz_run(tmp_path_factory, "conforming")))
+    assert np.allclose(cut["x"], gmsh["x"], atol=1e-12)
+    h = metrics(hertz)["mesh"]["h_contact"]
+    pc, pg = (window_average(d["x"], d["p_n"], h) for d in (cut, gmsh))
+    assert np.linalg.norm(pc - pg) <= 0.01 * np.linalg.norm(pg)
+    assert np.linalg.norm(cut["p_n"] - gmsh["p_n"]) <= 0.025 * np.linalg.norm(gmsh["p_n"])
 
 
 def test_hertz_against_analytic(hertz):
@@ -76,9 +105,10 @@ def test_tractions_csv_contract(hertz):
     assert np.all(data["p_n"][~active] == 0)
 
 
-def test_mindlin_stick_zone(tmp_path):
+@pytest.mark.parametrize("disc", ["conforming", "cut"])
+def test_mindlin_stick_zone(tmp_path, disc):
     out = tmp_path / "mindlin"
-    r = run("hertz.py", out, "--mu", "0.3", "--tangential", "0.5")
+    r = run("hertz.py", out, "--mu", "0.3", "--tangential", "0.5", "--discretization", disc)
     assert r.returncode == 0, r.stderr
     m = metrics(out)
     res, an = m["results"], m["analytic"]
@@ -87,7 +117,9 @@ def test_mindlin_stick_zone(tmp_path):
     assert res["traction_rel_l2_error"] <= 0.08
 
 
-@pytest.mark.parametrize("args", [[], ["--triangles"]])
+@pytest.mark.parametrize("args", [[], ["--triangles"], ["--discretization", "cut"],
+                                  ["--discretization", "cut", "--interface", "0.5000001"],
+                                  ["--discretization", "cut", "--h", "0.2", "--interface", "0.77"]])
 def test_patch_test_exact(tmp_path, args):
     out = tmp_path / "patch"
     r = run("patch_test.py", out, *args)
@@ -100,10 +132,13 @@ def test_patch_test_exact(tmp_path, args):
     assert an["pressure"] == pytest.approx(0.010989011, rel=1e-8)
 
 
-def test_patch_test_stiff_penalty_tends_to_exact(tmp_path):
+@pytest.mark.parametrize("args", [[], ["--discretization", "cut", "--interface", "0.3141"],
+                                  ["--discretization", "cut", "--interface", "0.6251"]])
+def test_patch_test_stiff_penalty_tends_to_exact(tmp_path, args):
+    """eps0 = 1e-6: the penalised pressure is 1.4e-7 from 0.010989011 (eq 51 compliance)."""
     out = tmp_path / "patch"
-    assert run("patch_test.py", out, "--eps0", "1e-6").returncode == 0
-    assert metrics(out)["results"]["pressure_rel_error_vs_exact"] <= 2e-6
+    assert run("patch_test.py", out, "--eps0", "1e-6", *args).returncode == 0
+    assert metrics(out)["results"]["pressure_rel_error_vs_exact"] <= 1e-6
 
 
 @pytest.mark.parametrize("demo,args,name", [
@@ -116,6 +151,10 @@ def test_patch_test_stiff_penalty_tends_to_exact(tmp_path):
     ("hertz.py", ["--tangential", "0.5"], "--tangential"),
     ("patch_test.py", ["--h", "0.3"], "--h"),
     ("patch_test.py", ["--nu", "0.7"], "--nu"),
+    ("patch_test.py", ["--discretization", "cut", "--interface", "0.5"], "--interface"),
+    ("patch_test.py", ["--interface", "0.3"], "--interface"),
+    ("hertz.py", ["--discretization", "cut", "--degree", "2"], "--degree"),
+    ("hertz.py", ["--discretization", "cut", "--ghost-penalty", "-1"], "--ghost-penalty"),
 ])
 def test_bad_input(tmp_path, demo, args, name):
     out = tmp_path / "never"

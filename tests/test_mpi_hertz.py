@@ -1,4 +1,5 @@
-"""Hertz contact on 2 MPI ranks gives the reaction of 1 rank (run under mpirun -n 2).
+"""Hertz contact on 2 MPI ranks gives the reaction of 1 rank (run under mpirun -n 2),
+body-fitted and cut (cut cells, ghost-penalty facets across the partition boundary).
 
 The scene partitioner puts every cell of the contact search box on rank 0, so the contact
 points and both bodies' cells around them are local there; the other rank only assembles
@@ -11,11 +12,13 @@ import pytest
 from mpi4py import MPI
 
 from dolfinx_forms.solver import ContactProblem, Dirichlet
+from meshes.cut import hertz_cut_scene
 from meshes.hertz import hertz_scene
 
 
-def reaction(comm, mu):
-    scene = hertz_scene(comm, R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.6)
+def reaction(comm, mu, disc="conforming"):
+    make = hertz_cut_scene if disc == "cut" else hertz_scene
+    scene = make(comm, R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.6)
     mat = {b.tag: (1e4, 0.3) for b in scene.bodies}
     top_x = Dirichlet("cylinder_top", 0, 0.0)
     top_y = Dirichlet("cylinder_top", 1, lambda lam: -0.15 * lam)
@@ -33,12 +36,13 @@ def reaction(comm, mu):
 
 
 @pytest.mark.mpi
-@pytest.mark.parametrize("mu", [0.0, 0.3])
-def test_two_ranks_match_one(mu):
+@pytest.mark.parametrize("mu,disc", [(0.0, "conforming"), (0.3, "conforming"), (0.0, "cut"),
+                                     (0.3, "cut")])
+def test_two_ranks_match_one(mu, disc):
     world = MPI.COMM_WORLD
     assert world.size == 2, "run under mpirun -n 2"
-    r2, n2 = reaction(world, mu)
-    r1, n1 = reaction(MPI.COMM_SELF, mu)
+    r2, n2 = reaction(world, mu, disc)
+    r1, n1 = reaction(MPI.COMM_SELF, mu, disc)
     assert n1 == n2
     assert abs(r2[1]) > 100
     np.testing.assert_allclose(r2, r1, rtol=1e-8, atol=1e-8 * abs(r1[1]))

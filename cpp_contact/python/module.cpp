@@ -8,6 +8,7 @@ void bind_geometry(py::module_& m);
 void bind_contact(py::module_& m);
 void bind_assembly(py::module_& m);
 void bind_location(py::module_& m);
+void bind_cut(py::module_& m);
 
 PYBIND11_MODULE(_cpp, m) {
   m.doc() = "ILS contact core: level sets, closest points, contact surface, return mapping";
@@ -15,4 +16,5 @@ PYBIND11_MODULE(_cpp, m) {
   bind_contact(m);
   bind_assembly(m);
   bind_location(m);
+  bind_cut(m);
 }

@@ -1,0 +1,75 @@
+// Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
+#pragma once
+
+// Cut-cell geometry and quadrature on the reference square, and the element kernels of the
+// cut path (section 4.2). Pure numerics: no DOLFINx here; the kernels only follow the
+// ufcx tabulate_tensor ABI so that DOLFINx can call them as custom integrals.
+//
+// Conventions (DOLFINx quadrilateral): reference square [0,1]^2, vertices in tensor order
+// v0 (0,0), v1 (1,0), v2 (0,1), v3 (1,1); facets f0 (v0,v1), f1 (v0,v2), f2 (v1,v3),
+// f3 (v2,v3). The level set phi is given by its values at the four vertices; the body is
+// {phi < 0}. Inside a cut cell the zero contour is the straight segment between the zero
+// crossings of phi on the cell edges (linear interpolation along each edge); when the four
+// edges all carry a crossing (saddle) the centre value (mean of the four) decides whether the
+// two inside corners are connected.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace contact::cut {
+
+/// Largest number of triangles `clip_square` returns.
+constexpr int max_triangles = 4;
+
+/// Layout of the packed coefficients `w` that the cut kernels read (one source of truth: the
+/// Python forms are built to match it and check it). Bilinear form: w = [phi(4), mu, lambda];
+/// traction form: w = [phi(4), t(18)] with t a vector Q2 function (9 nodes x 2, interleaved).
+struct Layout {
+  static constexpr int phi = 0;      ///< offset of the 4 vertex values of phi
+  static constexpr int lame = 4;     ///< offset of (mu, lambda), a DG0 vector (bilinear form)
+  static constexpr int traction = 4; ///< offset of the Q2 vector traction (linear form)
+  static constexpr int bilinear_size = 6;
+  static constexpr int traction_size = 22;
+};
+
+/// @brief Triangulate the inside part {phi_h < 0} of the reference square.
+/// @param phi level-set values at the 4 vertices (tensor order)
+/// @param triangles output: up to `max_triangles` triangles, 6 reference coordinates each
+///   (X0, Y0, X1, Y1, X2, Y2), counter-clockwise
+/// @return the number of triangles (0 if the cell is outside, 2 if it is entirely inside)
+int clip_square(std::span<const double, 4> phi, std::span<double, 6 * max_triangles> triangles);
+
+/// @brief Quadrature rule on the inside part of the reference square.
+/// @param phi vertex values (tensor order)
+/// @param degree polynomial degree integrated exactly on each sub-triangle (1, 2 or 4)
+/// @param points appended reference points (X, Y)
+/// @param weights appended weights (reference area: the full square has total weight 1)
+void cut_square_rule(std::span<const double, 4> phi, int degree, std::vector<double>& points,
+                     std::vector<double>& weights);
+
+/// @brief Inside part of a reference segment [0, 1] with end values phi0, phi1.
+/// @return the sub-interval [s0, s1] (s0 == s1 when the segment is outside)
+std::array<double, 2> clip_segment(double phi0, double phi1);
+
+/// @brief Area fraction of the inside part of the reference square (0..1).
+double inside_fraction(std::span<const double, 4> phi);
+
+/// @brief Cut-cell plane-strain elasticity matrix of a vector Q1 quadrilateral (ufcx ABI).
+///
+/// A (8x8, row-major, dof = node*2 + component) += int_{cell, phi_h<0} 2 mu eps(u):eps(v) +
+/// lambda div u div v, with a degree-2 rule on each sub-triangle (exact on parallelograms).
+/// w: see `Layout` (phi at the vertices, then mu, lambda). coordinate_dofs: 4 nodes x 3.
+void elasticity_q1(double* A, const double* w, const double* c, const double* coordinate_dofs,
+                   const int* entity_local_index, const std::uint8_t* quad_perm);
+
+/// @brief Traction load on the inside part of a boundary facet of a cut cell (ufcx ABI).
+///
+/// b (8, dof = node*2 + component) += int_{facet, phi_h<0} t . v ds, where t is a vector Q2
+/// function (its trace on the facet is the quadratic through the two vertex values and the
+/// edge-midpoint value) and phi_h is linear along the facet. entity_local_index[0] = facet.
+void traction_q1(double* A, const double* w, const double* c, const double* coordinate_dofs,
+                 const int* entity_local_index, const std::uint8_t* quad_perm);
+
+} // namespace contact::cut

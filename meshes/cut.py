@@ -1,0 +1,478 @@
+"""Structured-grid (cut-cell) scenes: the counterparts of the body-fitted gmsh scenes.
+
+Geometry: a tensor-product background grid of quadrilaterals (x lines `xlines`, y lines
+`ylines`, strictly increasing, uniform or graded, see :func:`graded_lines`). Body b is
+  window_b ∩ {cut_shape_b < 0},
+window_b = [x0, x1] x [y0, y1] with all four bounds grid lines (its grid-aligned sides carry
+the Dirichlet conditions and tractions), cut_shape_b a dolfinx_forms shape (< 0 inside) whose
+zero contour alone cuts cells (so no kink of the level set lies inside a cell at the window
+corners). The exact shape for contact is Body.shape = Intersection([cut_shape, Box(window)]).
+Active cells of body b: the grid cells inside its window with min(phi) < 0 over their four
+vertices (phi = cut_shape at the vertices); a cell is "interior" (kind 0) if max(phi) <= 0, else
+"cut" (kind 1). All bodies' active cells form ONE quadrilateral DOLFINx mesh as a disjoint
+union: each body has its own vertices (coincident, distinct vertices where bodies overlap
+the same grid region). The body tag and kind of every cell come from the construction (carried
+through the distribution by the topology's original cell index), not from the shapes.
+Ghost facets (tag 1): interior facets (two cells of one body) with at least one cut cell.
+Boundaries: named facet tags as in the gmsh scenes; names on a cut (non grid-aligned)
+boundary are kept in Scene.boundaries but mark no facet.
+Generators (same body names/tags, boundary names, pairs and contact boxes as meshes/*.py):
+  hertz_cut_scene       block window [-W, W] x [-depth, 0] (no cut cell), cylinder window
+                        [-R, R] x [0, R] cut by Circle((0, R), R); graded grid, spacing h on
+                        [-zone, zone]^2 (zone rounded up to a multiple of h)
+  patch_cut_scene       [0, width] x [0, height] split at y = interface (not a grid line)
+  two_blocks_cut_scene  the two blocks, interface y = height mid-cell (ny odd)
+  incline_cut_scene     the square cut by y = slope x + intercept
+Run: /usr/bin/python3 -m meshes.cut [--scene hertz] [--h 0.05] [--n 5]   (from the repository root)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import dolfinx
+import dolfinx.fem
+import dolfinx.mesh
+import numpy as np
+import ufl
+
+from .hertz import hertz_contact_box
+from .scene import Body, Scene, contact_partitioner, on_box_side, summary, tag_boundaries
+
+__all__ = ["CutBody", "CutData", "graded_lines", "half_plane", "cut_scene", "levelset_values",
+           "hertz_cut_scene", "patch_cut_scene", "two_blocks_cut_scene", "incline_cut_scene",
+           "cut_counts", "INTERIOR", "CUT"]
+
+INTERIOR, CUT = 0, 1  # CutData.kind_tags values
+GHOST_FACET = 1  # CutData.ghost_facets value
+
+
+# --------------------------------------------------------------------------- grid lines
+def _grade(length, s0, growth, h_far):
+    """Spacings (n,) summing exactly to `length` > 0, continuing a grid whose last spacing is
+    s0: n is the fewest spacings min(s0 r^i, h_far), i = 1..n, that reach `length` with
+    r = growth; then r in [1, growth] is lowered until they sum to `length` exactly. If even
+    r = 1 overshoots (a short segment), n uniform spacings length / n (>= s0 / 2 for n >= 2)."""
+    s1 = min(s0 * growth, h_far)
+    nmax = np.ceil(length / s1) + 2  # the spacings are >= s1, and grow geometrically to h_far
+    if growth > 1:
+        ngeo = np.ceil(np.log1p(length * (growth - 1) / s1) / np.log(growth))
+        nmax = min(nmax, ngeo + np.ceil(length / h_far) + 2)
+    i = np.arange(1, int(nmax) + 1)
+
+    def seq(r):
+        return np.minimum(s0 * r ** i, h_far)
+
+    n = int(np.searchsorted(np.cumsum(seq(growth)), length * (1 - 1e-12))) + 1
+    i = i[:n]
+    if n * min(s0, h_far) > length:
+        return np.full(n, length / n)
+    lo, hi = 1.0, growth
+    for _ in range(60):  # bisection on the growth rate (a scalar: 60 halvings of [1, growth])
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if seq(mid).sum() < length else (lo, mid)
+    s = seq(hi)
+    return s * (length / s.sum())
+
+
+def _graded_side(points, s0, growth, h_far):
+    """Lines beyond points[0] through each of points[1:] (increasing distances from the fine
+    zone, all hit exactly), the first spacing continuing s0."""
+    out = []
+    for p0, p1 in zip(points[:-1], points[1:]):  # a few required points, not cells
+        s = _grade(p1 - p0, s0, growth, h_far)
+        q = p0 + np.cumsum(s)
+        q[-1] = p1
+        out.append(q)
+        s0 = s[-1]
+    return np.concatenate(out) if out else np.zeros(0)
+
+
+def graded_lines(a, b, fine, h, growth=1.2, h_far=None, required=()) -> np.ndarray:
+    """Strictly increasing grid lines from a to b (both lines).
+
+    On fine = (c0, c1) the lines are exactly c0 + k h (c0 and c1 are lines: (c1 - c0) / h must
+    be an integer to 1e-9); outside, the spacing grows geometrically by at most `growth` per
+    line, up to h_far (None: no cap), and every point of `required` (e.g. 0, -depth, R) is a
+    line exactly: the grid is graded piecewise between consecutive required points, each piece
+    scaled to fit (see _grade). A required point inside the fine zone must be on its lattice.
+    Spacings can only get smaller than h / 2 where required points are closer than that.
+    """
+    a, b, h, growth = float(a), float(b), float(h), float(growth)
+    c0, c1 = (float(c) for c in fine)
+    h_far = np.inf if h_far is None else max(float(h_far), h)
+    if not h > 0:
+        raise ValueError(f"graded_lines: h must be > 0, got h={h}")
+    if not growth >= 1:
+        raise ValueError(f"graded_lines: growth must be >= 1, got growth={growth}")
+    if not a <= c0 <= c1 <= b or a == b:
+        raise ValueError(f"graded_lines: need a <= fine[0] <= fine[1] <= b and a < b, got a={a}, "
+                         f"fine=({c0}, {c1}), b={b}")
+    k = (c1 - c0) / h
+    if abs(k - round(k)) > 1e-9:
+        raise ValueError(f"graded_lines: fine=({c0}, {c1}) is not a whole number of cells of "
+                         f"h={h} ((c1 - c0) / h = {k!r})")
+    tol = 1e-9 * h
+    fine_lines = c0 + h * np.arange(round(k) + 1)
+    fine_lines[-1] = c1
+    req = np.unique(np.concatenate([np.asarray(required, float).ravel(), [a, b]]))
+    if req[0] < a - tol or req[-1] > b + tol:
+        raise ValueError(f"graded_lines: required={list(required)} has points outside [{a}, {b}]")
+    in_fine = (req >= c0 - tol) & (req <= c1 + tol)
+    idx = np.rint((req[in_fine] - c0) / h).astype(int)
+    off = np.abs(req[in_fine] - fine_lines[idx]) > tol
+    if off.any():
+        raise ValueError(f"graded_lines: required={list(required)}: {req[in_fine][off]} lie in "
+                         f"fine=({c0}, {c1}) but not on its lines {c0} + k*{h}")
+    fine_lines[idx] = req[in_fine]  # exactly the required values (e.g. 0, not 2e-17)
+    right = _graded_side(np.concatenate([[c1], req[req > c1 + tol]]), h, growth, h_far)
+    left = _graded_side(-np.concatenate([[c0], req[req < c0 - tol][::-1]]), h, growth, h_far)
+    lines = np.concatenate([-left[::-1], fine_lines, right])  # mirrored: the points stay exact
+    assert np.all(np.diff(lines) > 0), "graded_lines: lines not strictly increasing"
+    return lines
+
+
+def half_plane(point, normal, extent) -> object:
+    """The half-plane {(x - point) . normal < 0} (normal: outward) as a dolfinx_forms Polygon, a
+    square of side 2 extent on the line through `point`: its signed distance is exact within
+    `extent` of `point` (use extent >> the scene)."""
+    import dolfinx_forms as df
+
+    p, n = np.asarray(point, float), np.asarray(normal, float) / np.linalg.norm(normal)
+    t = np.array([-n[1], n[0]])
+    L = float(extent)
+    return df.Polygon(np.array([p - L * t, p + L * t, p + L * (t - 2 * n), p - L * (t + 2 * n)]))
+
+
+# --------------------------------------------------------------------------- the cut scene
+@dataclass
+class CutBody:
+    name: str
+    tag: int
+    window: np.ndarray  # (2, 2) [[x0, y0], [x1, y1]], all four values grid lines
+    shape: object  # the cut level set (only its zero contour cuts cells), < 0 inside
+    bbox: np.ndarray | None = None  # (2, 2) bounding box of the body; None: from the grid
+
+
+@dataclass
+class CutData:
+    xlines: np.ndarray
+    ylines: np.ndarray
+    windows: dict[int, np.ndarray]  # body tag -> (2, 2) window
+    levelsets: dict[int, object]  # body tag -> cut shape
+    kind_tags: dolfinx.mesh.MeshTags  # cells (owned + ghost): INTERIOR 0 / CUT 1
+    ghost_facets: dolfinx.mesh.MeshTags  # value 1 on the interior facets touching a cut cell
+
+
+def _line_index(lines, values, what):
+    """Indices of `values` in `lines` (to 1e-9 of the grid extent), else ValueError."""
+    tol = 1e-9 * (lines[-1] - lines[0])
+    i = np.clip(np.searchsorted(lines, values), 1, len(lines) - 1)
+    i = np.where(np.abs(lines[i - 1] - values) < np.abs(lines[i] - values), i - 1, i)
+    bad = np.abs(lines[i] - values) > tol
+    if bad.any():
+        raise ValueError(f"{what}: {np.asarray(values)[bad]} not on the grid lines")
+    return i
+
+
+def _body_grid(xlines, ylines, body):
+    """Rank 0: (vertices (nv, 2), cells (nc, 4) DOLFINx order, kinds (nc,), bbox (2, 2)) of
+    the active cells of one body, vertices numbered from 0 (only those of active cells)."""
+    w = np.asarray(body.window, float)
+    if w.shape != (2, 2) or not np.all(w[1] > w[0]):
+        raise ValueError(f"body {body.name!r}: window must be [[x0, y0], [x1, y1]] with x0 < x1 "
+                         f"and y0 < y1, got {w.tolist()}")
+    i0, i1 = _line_index(xlines, w[:, 0], f"body {body.name!r}: window x bounds")
+    j0, j1 = _line_index(ylines, w[:, 1], f"body {body.name!r}: window y bounds")
+    X, Y = xlines[i0:i1 + 1], ylines[j0:j1 + 1]
+    nx, ny = len(X) - 1, len(Y) - 1
+    pts = np.stack(np.meshgrid(X, Y), axis=-1).reshape(-1, 2)  # vertex (i, j) is j (nx+1) + i
+    phi = np.asarray(body.shape(pts), float)
+    v = (np.arange(ny)[:, None] * (nx + 1) + np.arange(nx)[None, :]).ravel()
+    quads = np.stack([v, v + 1, v + nx + 1, v + nx + 2], axis=1)
+    pc = phi[quads]
+    active = pc.min(axis=1) < 0
+    if not active.any():
+        raise ValueError(f"body {body.name!r}: no active cell (cut shape >= 0 at every vertex of "
+                         f"window {w.tolist()})")
+    kinds = np.where(pc[active].max(axis=1) > 0, CUT, INTERIOR).astype(np.int32)
+    used, cells = np.unique(quads[active], return_inverse=True)
+    bbox = body.bbox
+    if bbox is None:  # vertices inside plus the zero crossings (linear) on the grid edges
+        P = phi.reshape(ny + 1, nx + 1)
+        G = pts.reshape(ny + 1, nx + 1, 2)
+        found = [pts[phi <= 0]]
+        for ax in (0, 1):  # edges along y (ax 0) and along x (ax 1)
+            sl0 = (slice(None, -1), slice(None)) if ax == 0 else (slice(None), slice(None, -1))
+            sl1 = (slice(1, None), slice(None)) if ax == 0 else (slice(None), slice(1, None))
+            pa, pb = P[sl0], P[sl1]
+            cross = (pa <= 0) != (pb <= 0)
+            t = pa[cross] / (pa[cross] - pb[cross])
+            found.append(G[sl0][cross] + t[:, None] * (G[sl1][cross] - G[sl0][cross]))
+        found = np.concatenate(found)
+        bbox = np.array([found.min(axis=0), found.max(axis=0)])
+    return pts[used], cells.reshape(-1, 4), kinds, np.asarray(bbox, float)
+
+
+def _ghost_facets(mesh, kinds):
+    """MeshTags (value GHOST_FACET) on the local facets with two local cells, one of them cut."""
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    f2c = mesh.topology.connectivity(tdim - 1, tdim)
+    off = f2c.offsets
+    interior = np.flatnonzero(np.diff(off) == 2)
+    a, b = f2c.array[off[interior]], f2c.array[off[interior] + 1]
+    facets = interior[(kinds[a] == CUT) | (kinds[b] == CUT)].astype(np.int32)
+    values = np.full(len(facets), GHOST_FACET, np.int32)
+    tags = dolfinx.mesh.meshtags(mesh, tdim - 1, facets, values)
+    tags.name = "ghost_facets"
+    return tags
+
+
+def cut_scene(comm, xlines, ylines, bodies, boundary_markers, pairs, h_contact, contact_box=None,
+              ghost_mode=dolfinx.mesh.GhostMode.shared_facet) -> Scene:
+    """Collective: the cut-cell Scene (cell_type "quadrilateral", Scene.cut set) of `bodies`
+    (CutBody or (name, tag, window, cut_shape[, bbox]) tuples) on the grid xlines x ylines.
+
+    boundary_markers, pairs, contact_box: as in :func:`meshes.scene.scene_from_gmsh`. Rank 0
+    builds the cells and passes them to create_mesh (the other ranks pass empty arrays); the
+    body tag and kind of each cell reach the owner and ghosts through
+    topology.original_cell_index. ValueError (on every rank) if a window bound is not a grid
+    line or a body has no active cell.
+    """
+    import dolfinx_forms as df
+
+    xlines, ylines = (np.asarray(v, float) for v in (xlines, ylines))
+    bodies = [b if isinstance(b, CutBody) else CutBody(*b) for b in bodies]
+    status = None
+    if comm.rank == 0:
+        try:
+            for name, lines in (("xlines", xlines), ("ylines", ylines)):
+                if lines.ndim != 1 or len(lines) < 2 or not np.all(np.diff(lines) > 0):
+                    raise ValueError(f"cut_scene: {name} must be strictly increasing (>= 2 lines)")
+            parts = [_body_grid(xlines, ylines, b) for b in bodies]
+            offsets = np.cumsum([0] + [len(p[0]) for p in parts])
+            x = np.concatenate([p[0] for p in parts])
+            cells = np.concatenate([p[1] + o for p, o in zip(parts, offsets)]).astype(np.int64)
+            counts = [len(p[1]) for p in parts]
+            tags = np.repeat(np.array([b.tag for b in bodies], np.int32), counts)
+            kinds = np.concatenate([p[2] for p in parts])
+            status = ("ok", tags, kinds, [p[3] for p in parts])
+        except Exception as e:  # every rank raises (the others would wait in bcast)
+            error = e
+            status = ("error", isinstance(e, ValueError), str(e))
+    status = comm.bcast(status, root=0)
+    if status[0] != "ok":
+        if comm.rank == 0:
+            raise error
+        raise (ValueError if status[1] else RuntimeError)(f"rank 0: {status[2]}")
+    _, tags, kinds, bboxes = status
+    if comm.rank != 0:
+        x, cells = np.zeros((0, 2)), np.zeros((0, 4), np.int64)
+
+    domain = ufl.Mesh(ufl.VectorElement("Lagrange", ufl.quadrilateral, 1))
+    kwargs = {}
+    if contact_box is not None:
+        kwargs["partitioner"] = contact_partitioner(x, cells, "quadrilateral", contact_box)
+    mesh = dolfinx.mesh.create_mesh(comm, cells, x, domain, ghost_mode=ghost_mode, **kwargs)
+
+    tdim = mesh.topology.dim
+    original = np.asarray(mesh.topology.original_cell_index)  # owned + ghost: index on rank 0
+    local = np.arange(len(original), dtype=np.int32)
+    cvalues, ckinds = tags[original], kinds[original]
+    cell_tags = dolfinx.mesh.meshtags(mesh, tdim, local, cvalues)
+    cell_tags.name = "bodies"
+    kind_tags = dolfinx.mesh.meshtags(mesh, tdim, local, ckinds)
+    kind_tags.name = "kinds"
+    windows = {b.tag: np.asarray(b.window, float) for b in bodies}
+    scene_bodies = [Body(b.name, b.tag, df.Intersection([b.shape, df.Box(*windows[b.tag])]), bbox)
+                    for b, bbox in zip(bodies, bboxes)]
+    facet_tags, boundaries = tag_boundaries(mesh, cvalues, scene_bodies, boundary_markers)
+    cut = CutData(xlines=xlines, ylines=ylines, windows=windows,
+                  levelsets={b.tag: b.shape for b in bodies}, kind_tags=kind_tags,
+                  ghost_facets=_ghost_facets(mesh, ckinds))
+    return Scene(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, boundaries=boundaries,
+                 bodies=scene_bodies, pairs=[tuple(p) for p in pairs], h_contact=float(h_contact),
+                 cell_type="quadrilateral", cut=cut)
+
+
+def levelset_values(scene: Scene, V) -> dolfinx.fem.Function:
+    """A Function on the scalar Q1 space V of scene.mesh holding at each dof the cut shape of the
+    body owning it (the bodies are disjoint: every dof belongs to one body); ghosts updated."""
+    phi = dolfinx.fem.Function(V)
+    ncells = len(scene.cell_tags.values)
+    cell_dofs = V.dofmap.list.array.reshape(ncells, -1)
+    xdof = V.tabulate_dof_coordinates()[:, :2]
+    for tag, shape in scene.cut.levelsets.items():
+        dofs = np.unique(cell_dofs[scene.cell_tags.values == tag])
+        if len(dofs):
+            phi.x.array[dofs] = np.asarray(shape(np.ascontiguousarray(xdof[dofs])))
+    phi.x.scatter_forward()
+    return phi
+
+
+# --------------------------------------------------------------------------- generators
+def _nothing(x):
+    """Marker predicate for a cut (not grid-aligned) boundary: no facet."""
+    return np.zeros(x.shape[1], dtype=bool)
+
+
+def _window_markers(windows, specs, tol):
+    """boundary_markers for cut_scene: specs [(name, body, window sides or None)] give name ->
+    (tag 1, 2, ... in order, predicate, body); the predicate matches the given sides of the
+    body's window (see on_box_side), None (a cut boundary, not grid aligned) matches nothing."""
+    def pred(body, sides):
+        return _nothing if sides is None else on_box_side(*windows[body], sides, tol)
+
+    return {name: (tag, pred(body, sides), body)
+            for tag, (name, body, sides) in enumerate(specs, start=1)}
+
+
+def hertz_cut_scene(comm, R=10.0, width=40.0, depth=20.0, h=0.05, zone=1.5, h_far=None,
+                    growth=1.2, contact_box=None) -> Scene:
+    """The Hertz scene of meshes/hertz.py on a graded grid (spacing h on [-z, z]^2, z = zone
+    rounded up to a multiple of h); the block has no cut cell, the cylinder is cut by its circle.
+    contact_box overrides hertz_contact_box(R, width, depth, zone)."""
+    import dolfinx_forms as df
+
+    W = width / 2
+    k = zone / h
+    z = zone if abs(k - round(k)) < 1e-9 else h * np.ceil(k)
+    if not z < min(R, W, depth):
+        raise ValueError(f"hertz_cut_scene: zone {z} (rounded up to a multiple of h) must be "
+                         f"< min(R, width/2, depth) = {min(R, W, depth)}")
+    h_far = max(h, min(R, depth) / 8 if h_far is None else h_far)
+    xmax = max(W, R)
+    xlines = graded_lines(-xmax, xmax, (-z, z), h, growth, h_far, required=[-W, -R, 0.0, R, W])
+    ylines = graded_lines(-depth, R, (-z, z), h, growth, h_far, required=[0.0])
+    m = max(R, W, depth)  # the block's cut box: the window with a margin, so no cell is cut
+    block = np.array([[-W, -depth], [W, 0.0]])
+    bodies = [
+        CutBody("block", 1, block, df.Box(block[0] - m, block[1] + m), block),
+        CutBody("cylinder", 2, np.array([[-R, 0.0], [R, R]]), df.Circle((0.0, R), R),
+                np.array([[-R, 0.0], [R, R]])),
+    ]
+    specs = [("block_bottom", 0, ["bottom"]), ("block_sides", 0, ["left", "right"]),
+             ("block_top", 0, ["top"]), ("cylinder_top", 1, ["top"]), ("cylinder_arc", 1, None)]
+    markers = _window_markers([b.window for b in bodies], specs, 1e-8 * max(R, width, depth))
+    box = hertz_contact_box(R, width, depth, zone) if contact_box is None else contact_box
+    return cut_scene(comm, xlines, ylines, bodies, markers, [(0, 1)], h, contact_box=box)
+
+
+def patch_cut_scene(comm, n=5, width=1.0, height=1.0, interface=0.5, nx=None) -> Scene:
+    """Patch test on a uniform grid: n cells over the height, nx (default round(n width /
+    height)) across; lower body [0, width] x [0, interface], upper [0, width] x [interface,
+    height]; `interface` must not be a grid line (ValueError): the test wants cut cells. The
+    default n = 5 keeps the gmsh patch's interface 0.5 mid-cell."""
+    nx = max(1, round(n * width / height)) if nx is None else int(nx)
+    xlines, ylines = np.linspace(0.0, width, nx + 1), np.linspace(0.0, height, n + 1)
+    hy = height / n
+    k = interface / hy
+    if not 0 < interface < height or abs(k - round(k)) < 1e-9:
+        raise ValueError(f"patch_cut_scene: interface={interface} must lie strictly inside "
+                         f"(0, {height}) and not on a grid line (spacing {hy})")
+    above, below = ylines[int(np.ceil(k))], ylines[int(np.floor(k))]
+    windows = [np.array([[0.0, 0.0], [width, above]]), np.array([[0.0, below], [width, height]])]
+    ext = 100 * max(width, height)
+    bodies = [
+        CutBody("lower", 1, windows[0], half_plane((0.0, interface), (0.0, 1.0), ext),
+                np.array([[0.0, 0.0], [width, interface]])),
+        CutBody("upper", 2, windows[1], half_plane((0.0, interface), (0.0, -1.0), ext),
+                np.array([[0.0, interface], [width, height]])),
+    ]
+    specs = [(f"{name}_{side}", body, None if side == cut else [side])
+             for body, (name, cut) in enumerate([("lower", "top"), ("upper", "bottom")])
+             for side in ("bottom", "left", "right", "top")]
+    markers = _window_markers(windows, specs, 1e-8 * max(width, height))
+    box = np.array([[0.0, interface - hy], [width, interface + hy]])
+    return cut_scene(comm, xlines, ylines, bodies, markers, [(0, 1)], max(width / nx, hy),
+                     contact_box=box)
+
+
+def two_blocks_cut_scene(comm, h=0.2, width_lower=40.0, height=10.0, width_upper=20.0) -> Scene:
+    """The two blocks of meshes/two_blocks.py on a uniform grid: x lines through 0, c -+
+    width_upper/2, width_lower (spacing <= about h), ny = the smallest odd integer >= 2 height / h
+    cells over [0, 2 height], so the interface y = height is mid-cell."""
+    c = width_lower / 2
+    req = np.array([0.0, c - width_upper / 2, c + width_upper / 2, width_lower])
+    gap = np.diff(np.unique(req))
+    gap = gap[gap > 0].min()
+    hx = gap / max(1, round(gap / h))
+    xlines = graded_lines(0.0, width_lower, (0.0, width_lower), hx, required=req)
+    ny = int(np.ceil(2 * height / h - 1e-9))
+    ny += 1 - ny % 2
+    ylines = np.linspace(0.0, 2 * height, ny + 1)
+    above, below = ylines[(ny + 1) // 2], ylines[(ny - 1) // 2]
+    u0, u1 = req[1:3]
+    windows = [np.array([[0.0, 0.0], [width_lower, above]]),
+               np.array([[u0, below], [u1, 2 * height]])]
+    ext = 100 * max(width_lower, 2 * height)
+    bodies = [
+        CutBody("lower", 1, windows[0], half_plane((0.0, height), (0.0, 1.0), ext),
+                np.array([[0.0, 0.0], [width_lower, height]])),
+        CutBody("upper", 2, windows[1], half_plane((0.0, height), (0.0, -1.0), ext),
+                np.array([[u0, height], [u1, 2 * height]])),
+    ]
+    specs = [("lower_bottom", 0, ["bottom"]), ("lower_left", 0, ["left"]),
+             ("lower_right", 0, ["right"]), ("lower_top", 0, None), ("upper_top", 1, ["top"]),
+             ("upper_bottom", 1, None), ("upper_sides", 1, ["left", "right"])]
+    markers = _window_markers(windows, specs, 1e-8 * width_lower)
+    box = np.array([[u0, height - 2 * h], [u1, height + 2 * h]])
+    return cut_scene(comm, xlines, ylines, bodies, markers, [(0, 1)], max(hx, ylines[1]),
+                     contact_box=box)
+
+
+def incline_cut_scene(comm, h=25.0, size=1000.0, slope=0.2, intercept=458.6) -> Scene:
+    """The square of meshes/incline.py on a uniform n x n grid, n = round(size / h); both
+    windows are the whole square, cut by half-planes below / above y = slope x + intercept."""
+    y0, y1 = intercept, slope * size + intercept
+    if not (0 < y0 < size and 0 < y1 < size):
+        raise ValueError("incline_cut_scene: the line must cross both vertical sides")
+    n = max(1, round(size / h))
+    lines = np.linspace(0.0, size, n + 1)
+    square = np.array([[0.0, 0.0], [size, size]])
+    up = np.array([-slope, 1.0])
+    polys = [np.array([[0, 0], [size, 0], [size, y1], [0, y0]]),
+             np.array([[0, y0], [size, y1], [size, size], [0, size]])]
+    bodies = [CutBody(name, i + 1, square, half_plane((0.0, intercept), sign * up, 100 * size),
+                      np.array([p.min(axis=0), p.max(axis=0)], float))
+              for i, (name, sign, p) in enumerate(zip(["lower", "upper"], [1, -1], polys))]
+    specs = [("lower_bottom", 0, ["bottom"]), ("upper_top", 1, ["top"]),
+             ("lower_sides", 0, ["left", "right"]), ("upper_sides", 1, ["left", "right"]),
+             ("lower_interface", 0, None), ("upper_interface", 1, None)]
+    markers = _window_markers([square, square], specs, 1e-8 * size)
+    box = np.array([[0.0, min(y0, y1) - 2 * h], [size, max(y0, y1) + 2 * h]])
+    return cut_scene(comm, lines, lines, bodies, markers, [(0, 1)], size / n, contact_box=box)
+
+
+def cut_counts(scene: Scene) -> dict[str, int]:
+    """Collective: global number of cut cells per body name."""
+    owned = scene.cell_tags.indices < scene.mesh.topology.index_map(2).size_local
+    cut = scene.cut.kind_tags.values == CUT
+    tags = scene.cell_tags.values
+    return {b.name: scene.mesh.comm.allreduce(int(np.sum(owned & cut & (tags == b.tag))))
+            for b in scene.bodies}
+
+
+if __name__ == "__main__":
+    import argparse
+
+    from mpi4py import MPI
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scene", choices=["hertz", "patch", "two_blocks", "incline"], default="hertz")
+    ap.add_argument("--h", type=float, default=None,
+                    help="grid spacing (hertz, two_blocks, incline; default: theirs)")
+    ap.add_argument("--n", type=int, default=5, help="patch: cells over the height")
+    args = ap.parse_args()
+    comm = MPI.COMM_WORLD
+    if args.scene == "patch":
+        s = patch_cut_scene(comm, n=args.n)
+    else:
+        make = {"hertz": hertz_cut_scene, "two_blocks": two_blocks_cut_scene,
+                "incline": incline_cut_scene}[args.scene]
+        s = make(comm) if args.h is None else make(comm, h=args.h)
+    line, counts = summary(s), cut_counts(s)
+    if comm.rank == 0:
+        print(f"{args.scene} (cut):", line)
+        print("cut cells:", ", ".join(f"{k}: {v}" for k, v in counts.items()))
