@@ -46,7 +46,7 @@ test-mpi:
 	$(MPIRUN) $(PYTHON) -m pytest -m mpi -p no:cacheprovider --color=no
 
 demo: build
-	$(PYTHON) demos/hertz.py --out $(OUT)/hertz
+	$(PYTHON) demos/hertz.py --discretization cut --out $(OUT)/hertz
 
 bench: build
 	mkdir -p benchmarks/results

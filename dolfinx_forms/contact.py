@@ -9,8 +9,9 @@ the reference configuration; Newton only changes u in the gaps (eqs 27-30). For 
    distance of the body's shape, C1 interpolation by the geometry core);
 3. Gamma_c (eqs 21-24) with Gauss points, normals n (body i -> j), tangents t;
 4. closest points P_i, P_j (eq 25), g_n0 = (P_j - P_i).n (eq 28);
-5. the mesh cells containing P_i and P_j (binned point location in C++) and the basis values
-   there (basix), packed into a `ContactQuadrature` for the C++ kernel (eq 48).
+5. the mesh cells containing P_i and P_j (binned point location in C++; on a cut scene's
+   structured grid, index arithmetic) and the basis values there (basix), packed into a
+   `ContactQuadrature` for the C++ kernel (eq 48).
 """
 
 from dataclasses import dataclass
@@ -72,6 +73,62 @@ class BodyLocator:
         return self.element.tabulate(0, X)[0, :, :, 0]
 
 
+class GridLocator:
+    """Point location among one body's active cells of a cut scene's structured grid: the grid
+    index of a point is found by bisection on the tensor lines and looked up in a table (no
+    search over cells), so the cost per point is O(1) in the number of cells. A point in an
+    inactive grid cell (e.g. a closest point on the exact boundary where the straight cut
+    misses a sliver) goes to the nearest active cell of the 3 x 3 neighbourhood, with
+    extrapolated reference coordinates, if it is within max_distance of it. `locate` returns
+    (cells, X, outside) like BodyLocator: outside = 0 inside a cell, else the distance to it
+    (inf and cell -1 when nothing is within max_distance)."""
+
+    def __init__(self, mesh, cell_tags, tag, cut, degree):
+        self.xl, self.yl = np.asarray(cut.xlines), np.asarray(cut.ylines)
+        self.table = np.full((len(self.xl) - 1, len(self.yl) - 1), -1, np.int32)
+        g = mesh.geometry.dofmap.array.reshape(-1, 4)
+        cells = cell_tags.indices[cell_tags.values == tag].astype(np.int32)
+        xv = mesh.geometry.x[g[cells], :2]  # (n, 4, 2)
+        self.v0, self.ex, self.ey = xv[:, 0], xv[:, 1] - xv[:, 0], xv[:, 2] - xv[:, 0]
+        centre = xv.mean(axis=1)
+        i, j = self._index(centre)
+        self.table[i, j] = np.arange(len(cells), dtype=np.int32)
+        self.cells, self.lo, self.hi = cells, xv.min(axis=1), xv.max(axis=1)
+        self.element = _basix_element("quadrilateral", degree)
+
+    def _index(self, p):
+        i = np.clip(np.searchsorted(self.xl, p[:, 0], side="right") - 1, 0, len(self.xl) - 2)
+        j = np.clip(np.searchsorted(self.yl, p[:, 1], side="right") - 1, 0, len(self.yl) - 2)
+        return i, j
+
+    def locate(self, points, max_distance):
+        p = np.asarray(points, float)[:, :2]
+        i, j = self._index(p)
+        best = np.full(len(p), -1, np.int32)
+        dist = np.full(len(p), np.inf)
+        for di in (0, -1, 1):  # own grid cell first; neighbours only where it is inactive
+            for dj in (0, -1, 1):
+                ii = np.clip(i + di, 0, self.table.shape[0] - 1)
+                jj = np.clip(j + dj, 0, self.table.shape[1] - 1)
+                k = self.table[ii, jj]
+                ok = k >= 0
+                d = np.full(len(p), np.inf)
+                d[ok] = np.linalg.norm(np.maximum(0, np.maximum(self.lo[k[ok]] - p[ok],
+                                                                p[ok] - self.hi[k[ok]])), axis=1)
+                better = d < dist
+                best[better], dist[better] = k[better], d[better]
+        found = (best >= 0) & (dist <= max_distance)
+        k = np.where(found, best, 0)
+        r = p - self.v0[k]
+        X = np.stack([np.einsum("ij,ij->i", r, self.ex[k]) / np.einsum("ij,ij->i", self.ex[k], self.ex[k]),
+                      np.einsum("ij,ij->i", r, self.ey[k]) / np.einsum("ij,ij->i", self.ey[k], self.ey[k])],
+                     axis=1)
+        return np.where(found, self.cells[k], -1), X, np.where(found, dist, np.inf)
+
+    def basis(self, X):
+        return self.element.tabulate(0, X)[0, :, :, 0]
+
+
 def pair_geometry(V, scene, pair, band, *, grid_refine=4, num_gauss=2, max_outside=None,
                   projection="shape"):
     """Contact quadrature of `pair` (indices into scene.bodies).
@@ -116,8 +173,12 @@ def pair_geometry(V, scene, pair, band, *, grid_refine=4, num_gauss=2, max_outsi
     dofmap = V.dofmap.list.array.reshape(-1, V.dofmap.dof_layout.num_dofs)
     max_outside = 0.5 * h if max_outside is None else max_outside
     sides = []
+    cut = getattr(scene, "cut", None)
     for body, p in ((bi, p_i), (bj, p_j)):
-        loc = BodyLocator(scene.mesh, scene.cell_tags, body.tag, scene.cell_type, degree)
+        if cut is not None:  # structured grid: O(1) location by index
+            loc = GridLocator(scene.mesh, scene.cell_tags, body.tag, cut, degree)
+        else:
+            loc = BodyLocator(scene.mesh, scene.cell_tags, body.tag, scene.cell_type, degree)
         cells, X, outside = loc.locate(p, max_outside)
         if np.any(cells < 0):
             bad = np.flatnonzero(cells < 0)[0]

@@ -166,3 +166,30 @@ def test_timing_200x200(cell_type):
         f"dolfinx BoundingBoxTree build {1e3 * (t5 - t4):.1f} ms, collisions "
         f"{1e3 * (t6 - t5):.1f} ms ({1e5 / (t6 - t5):.2e} points/s)"
     )
+
+
+def test_grid_locator_matches_binned_location_on_a_cut_scene():
+    """Cut scenes locate points by grid index (O(1)); same cells and reference coordinates as
+    the binned C++ locator for points inside active cells, and the nearest active cell for
+    points in inactive grid cells near the boundary."""
+    from dolfinx_forms.contact import BodyLocator, GridLocator
+    from meshes.cut import hertz_cut_scene
+
+    scene = hertz_cut_scene(MPI.COMM_SELF, R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.0)
+    rng = np.random.default_rng(3)
+    for body in scene.bodies:
+        grid = GridLocator(scene.mesh, scene.cell_tags, body.tag, scene.cut, 1)
+        bins = BodyLocator(scene.mesh, scene.cell_tags, body.tag, "quadrilateral", 1)
+        pts = rng.uniform([-2, -1], [2, 1.5], size=(4000, 2))
+        c1, X1, out1 = grid.locate(pts, 0.05)
+        c2, X2, out2 = bins.locate(pts, 0.05)
+        inside = out2 == 0
+        assert inside.sum() > 500
+        np.testing.assert_array_equal(c1[inside], c2[inside])
+        np.testing.assert_allclose(X1[inside], X2[inside], atol=1e-12)
+        # points outside every cell but within reach: both find a cell at the same distance
+        near = (out2 > 0) & (c2 >= 0)
+        assert near.sum() > 10
+        np.testing.assert_array_equal(c1 < 0, c2 < 0)
+        np.testing.assert_allclose(out1[near], out2[near], atol=1e-12)
+        np.testing.assert_allclose(grid.basis(X1[inside]), bins.basis(X2[inside]), atol=1e-12)
