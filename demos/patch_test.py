@@ -30,10 +30,9 @@ from dolfinx_forms.cli import (DemoParser, add_discretization, bounded,  # noqa:
                                check_discretization, petsc_options)
 from dolfinx_forms.output import atomic_output, finish, gather_points, plot_tractions  # noqa: E402
 from dolfinx_forms.results import PhaseTimer, new_metrics  # noqa: E402
-from dolfinx_forms.solver import (ContactProblem, ContactSolverError, Dirichlet,  # noqa: E402
-                                  solver_metrics)
+from dolfinx_forms.solver import ContactProblem, ContactSolverError, solver_metrics  # noqa: E402
 from meshes.cut import patch_cut_scene  # noqa: E402
-from meshes.patch import patch_scene  # noqa: E402
+from meshes.patch import patch_dirichlet, patch_scene  # noqa: E402
 
 
 def parse(argv):
@@ -95,10 +94,7 @@ def main(argv=None):
         scene, {b.tag: (args.E, args.nu) for b in scene.bodies}, mu=args.mu, eps0=args.eps0,
         band=0.5 * args.h, degree=args.degree, petsc_options=args.petsc, timer=timer,
         ghost_penalty=args.ghost_penalty,
-        dirichlet=[Dirichlet("lower_bottom", 1, 0.0),
-                   Dirichlet("upper_top", 1, lambda lam: -d * lam),
-                   Dirichlet(lambda x: np.isclose(x[0], 0) & np.isclose(x[1], 0), 0, 0.0),
-                   Dirichlet(lambda x: np.isclose(x[0], 0) & np.isclose(x[1], 1), 0, 0.0)])
+        dirichlet=patch_dirichlet(d))
     try:
         problem.solve(1, label="patch")
     except ContactSolverError as e:

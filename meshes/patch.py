@@ -58,3 +58,16 @@ if __name__ == "__main__":
     line = summary(s)
     if MPI.COMM_WORLD.rank == 0:
         print("patch:", line)
+
+
+def patch_dirichlet(d, height=1.0):
+    """The patch test's Dirichlet conditions on these boundary names (also those of
+    meshes.cut.patch_cut_scene): bottom u_y = 0, top u_y = -d lam, and u_x = 0 at the left end
+    of the bottom and of the top (one point per body: no rigid sliding)."""
+    from dolfinx_forms.solver import Dirichlet
+
+    def corner(y):
+        return lambda x: np.isclose(x[0], 0.0) & np.isclose(x[1], y)
+
+    return [Dirichlet("lower_bottom", 1, 0.0), Dirichlet("upper_top", 1, lambda lam: -d * lam),
+            Dirichlet(corner(0.0), 0, 0.0), Dirichlet(corner(height), 0, 0.0)]
