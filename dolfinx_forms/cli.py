@@ -56,7 +56,7 @@ def add_discretization(parser):
     """--discretization and the cut path's --ghost-penalty (shared by every demo)."""
     parser.add_argument("--discretization", choices=["conforming", "cut"], default="conforming",
                         help="body-fitted gmsh meshes, or level sets cutting a structured grid")
-    parser.add_argument("--ghost-penalty", type=bounded("--ghost-penalty", 0, None), default=0.1,
+    parser.add_argument("--ghost-penalty", type=bounded("--ghost-penalty", 0, None), default=0.01,
                         help="cut path: ghost-penalty factor on the faces of cut cells (0: off)")
 
 

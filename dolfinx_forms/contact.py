@@ -153,6 +153,10 @@ def pair_geometry(V, scene, pair, band, *, grid_refine=4, num_gauss=2, max_outsi
     phi_i = _cpp.levelset_from_shape(grid, bi.shape)
     phi_j = _cpp.levelset_from_shape(grid, bj.shape)
     s = _cpp.contact_surface(phi_i, phi_j, 0.5 * band, num_gauss)
+    # Gamma_c through level-set grid nodes leaves zero-length segments: drop their points
+    keep = s["weights"] > 1e-9 * dx
+    s = {k: (v[keep] if isinstance(v, np.ndarray) and len(v) == len(keep) else v)
+         for k, v in s.items()}
     if len(s["weights"]) == 0:
         return None
     if projection == "shape":  # exact shapes: exact closest points, corners included

@@ -82,7 +82,7 @@ class CutForms:
     Function of the level sets (default: `meshes.cut.levelset_values` of the scene), created
     before this object (coefficient order)."""
 
-    def __init__(self, V, scene, materials, ghost_penalty=0.1, phi=None):
+    def __init__(self, V, scene, materials, ghost_penalty=0.01, phi=None):
         from .solver import plane_strain
 
         if V.ufl_element().degree() != 1 or scene.cell_type != "quadrilateral":

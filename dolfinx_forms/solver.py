@@ -95,7 +95,7 @@ class ContactProblem:
 
     def __init__(self, scene, materials, *, mu=0.0, eps0=1.0, band=None, degree=1,
                  dirichlet=(), tractions=(), newton=None, petsc_options=None, grid_refine=4,
-                 num_gauss=2, timer=None, contact_rank=0, ghost_penalty=0.1, log=print):
+                 num_gauss=2, timer=None, contact_rank=0, ghost_penalty=0.01, log=print):
         self.scene, self.mesh = scene, scene.mesh
         self.comm = self.mesh.comm
         self.mu = float(mu)
