@@ -3,13 +3,18 @@
 
 Runs demos/hertz.py as one subprocess per run (so the timings of the runs are independent)
 at contact mesh sizes h = a/10, a/14, a/20, a/28, a/40 (a: the Hertz half-width of the demo
-defaults, ~1 mm) for each discretization variant, sequentially, and writes
+defaults, ~1 mm) for each discretization variant, sequentially. Variants: the body-fitted
+(gmsh) path p1-tri, p2-tri, p1-quad, p2-quad (hertz.py [--degree 2] [--quads]) and the cut path
+q1-cut (hertz.py --discretization cut: level sets on a graded structured grid, Q1, hertz.py's
+default ghost penalty); default p1-tri,p1-quad,q1-cut, so one run compares both paths. Writes
 
   <out-dir>/work_precision.json  the runs (h, dofs, phase wall times, Newton iterations,
                                  errors of a, p0 and p(x) against Hertz), per variant the
                                  observed convergence rates of each error vs h (least squares
                                  on log-log) and the time to reach 2 % pressure L2 error
                                  (log-log interpolation between the bracketing runs);
+                                 cut_vs_conforming: q1-cut's time to 2 % beside the fastest
+                                 conforming variant's;
   <out-dir>/work_precision.png   pressure L2 error vs wall time and vs dofs, and the stacked
                                  phase times of every run.
 
@@ -17,50 +22,60 @@ Both files are replaced atomically. A run whose demo exits non-zero is recorded 
 line of its stderr and left out of the rates and curves. Times are the demo's own phase timer
 (timing_s.total: mesh generation to the end of post-processing, without interpreter start-up
 and file output); the subprocess wall time is recorded beside it as wall_s.
+Running a demo and turning its metrics.json into errors is demos/convergence_study.py's
+run_hertz (shared, with the variants' arguments and the log-log fit).
 
-Usage: /usr/bin/python3 benchmarks/work_precision.py [--quick] [--variants p1-tri,p2-tri,p1-quad]
-                                                     [--out-dir benchmarks/results]
+Usage: /usr/bin/python3 benchmarks/work_precision.py [--quick] [--variants p1-tri,p1-quad,q1-cut]
+                                                     [--out-dir benchmarks/results] [--timeout S]
+  --quick: a/10, a/14, a/20 only (default variants p1-tri,q1-cut), a smoke run of ~1 minute.
 """
 
 import hashlib
+import importlib.util
 import json
 import math
 import os
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-import numpy as np  # noqa: E402
-
-from dolfinx_forms import analytic  # noqa: E402
 from dolfinx_forms.cli import DemoParser  # noqa: E402
 
-DEMO = ROOT / "demos" / "hertz.py"
-# The defaults of demos/hertz.py (DEFAULTS there); only used to place the mesh sizes at a/k.
-HERTZ_DEFAULTS = dict(R=10.0, E=1.0e4, nu=0.3, load=430.0)
+
+def _load_study():
+    """demos/convergence_study.py as a module (demos/ is not a package): run_hertz and the
+    variants live there, once."""
+    name = "convergence_study"
+    if name not in sys.modules:
+        spec = importlib.util.spec_from_file_location(name, ROOT / "demos" / f"{name}.py")
+        mod = importlib.util.module_from_spec(spec)
+        sys.modules[name] = mod
+        spec.loader.exec_module(mod)
+    return sys.modules[name]
+
+
+study = _load_study()
+DEMO = study.HERTZ
+HERTZ_DEFAULTS = study.CASE  # passed explicitly to every run
+VARIANTS = study.VARIANTS  # name -> extra demo arguments
+ERRORS, PHASES = study.ERRORS, study.PHASES
+loglog_rate = study.loglog_rate
 DIVISORS = (10, 14, 20, 28, 40)
 QUICK_DIVISORS = (10, 14, 20)
-VARIANTS = {  # name -> extra demo arguments
-    "p1-tri": [],
-    "p2-tri": ["--degree", "2"],
-    "p1-quad": ["--quads"],
-    "p2-quad": ["--degree", "2", "--quads"],
-}
-DEFAULT_VARIANTS = "p1-tri,p2-tri,p1-quad"
-ERRORS = ("half_width_rel_error", "peak_pressure_rel_error", "pressure_rel_l2_error")
-PHASES = ("mesh", "assembly", "contact", "solve")
+DEFAULT_VARIANTS = "p1-tri,p1-quad,q1-cut"  # p2-tri is selectable (about 8 minutes alone)
+QUICK_VARIANTS = "p1-tri,q1-cut"
 TARGET = 0.02  # pressure L2 error of the time-to-precision figure
 
 
 def parse(argv):
     p = DemoParser(prog="work_precision.py", description=__doc__.split("\n\n")[0])
     p.add_argument("--quick", action="store_true",
-                   help="smoke test: 3 coarse sizes (a/10, a/14, a/20), P1 triangles only")
+                   help=f"smoke test: 3 coarse sizes (a/10, a/14, a/20), variants "
+                        f"{QUICK_VARIANTS} unless --variants is given")
     p.add_argument("--variants", default=None,
                    help=f"comma-separated subset of {','.join(VARIANTS)} "
                         f"(default {DEFAULT_VARIANTS})")
@@ -69,11 +84,8 @@ def parse(argv):
     p.add_argument("--timeout", type=float, default=3600.0,
                    help="seconds before one demo run is killed and recorded as failed")
     a = p.parse_args(argv)
-    if a.quick and a.variants is not None:
-        p.error("--variants: --quick runs P1 triangles only; drop one of the two options")
-    names = [v.strip() for v in (a.variants or DEFAULT_VARIANTS).split(",")]
-    if a.quick:
-        names = ["p1-tri"]
+    names = [v.strip() for v in
+             (a.variants or (QUICK_VARIANTS if a.quick else DEFAULT_VARIANTS)).split(",")]
     bad = [v for v in names if v not in VARIANTS]
     if bad or not names:
         p.error(f"--variants: unknown variant {bad[0] if bad else ''!r}; "
@@ -88,9 +100,10 @@ def parse(argv):
 
 
 def code_digest():
-    """sha256 (12 hex) over the sources the demo runs (demo, package, meshes, compiled core):
+    """sha256 (12 hex) over the sources the demo runs (demo and its runner, package, meshes,
+    compiled core):
     others may edit the repository while the benchmark runs; a change shows up per run."""
-    files = [DEMO, *sorted((ROOT / "dolfinx_forms").glob("*.py")),
+    files = [DEMO, Path(study.__file__), *sorted((ROOT / "dolfinx_forms").glob("*.py")),
              *sorted((ROOT / "dolfinx_forms").glob("_cpp*.so")),
              *sorted((ROOT / "meshes").glob("*.py"))]
     h = hashlib.sha256()
@@ -113,68 +126,15 @@ def git_head():
 
 
 def hertz_half_width():
-    d = HERTZ_DEFAULTS
-    E_star = analytic.effective_modulus(d["E"], d["nu"], d["E"], d["nu"])
-    return float(analytic.hertz_line(d["load"], d["R"], E_star)[0])
-
-
-def last_line(text, fallback):
-    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
-    return lines[-1] if lines else fallback
+    return study.hertz_reference()[0]
 
 
 def run_one(variant, divisor, h, timeout):
     """One demo run in a scratch folder; returns the run record (ok or failed)."""
-    rec = dict(variant=variant, h_divisor=divisor, h=h, code_sha256=code_digest())
-    with tempfile.TemporaryDirectory(prefix="work_precision.") as tmp:
-        out = Path(tmp) / "hertz"
-        cmd = [sys.executable, str(DEMO.relative_to(ROOT)), "--out", str(out), "--h", repr(h),
-               *VARIANTS[variant]]
-        rec["command"] = " ".join(cmd[1:])
-        t0 = time.perf_counter()
-        try:
-            proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=timeout)
-        except subprocess.TimeoutExpired:
-            rec.update(ok=False, returncode=None, wall_s=time.perf_counter() - t0,
-                       error=f"killed after the {timeout:g} s timeout")
-            return rec
-        rec["wall_s"] = time.perf_counter() - t0
-        rec["returncode"] = proc.returncode
-        if proc.returncode != 0:
-            rec.update(ok=False, error=last_line(proc.stderr, f"exit status {proc.returncode}"))
-            return rec
-        try:
-            m = json.loads((out / "metrics.json").read_text())
-            res, ana = m["results"], m["analytic"]
-            a, p0 = res["contact_half_width"], res["peak_pressure"]
-            l2 = res["pressure_rel_l2_error"]
-            aH, p0H = ana["contact_half_width"], ana["peak_pressure"]
-            errors = dict(half_width_rel_error=abs(a - aH) / aH,
-                          peak_pressure_rel_error=abs(p0 - p0H) / p0H,
-                          pressure_rel_l2_error=l2)
-            if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in errors.values()):
-                raise ValueError(f"non-finite error in metrics.json: {errors}")
-            timing = {k: float(m["timing_s"][k]) for k in ("total", *PHASES)}
-        except (OSError, KeyError, TypeError, ValueError, ZeroDivisionError) as e:
-            rec.update(ok=False, error=f"hertz.py exited 0 but metrics.json is unusable: {e}")
-            return rec
-    its = m["solver"]["newton_iterations"]
-    rec.update(ok=True, num_dofs=int(m["mesh"]["num_dofs"]), num_cells=int(m["mesh"]["num_cells"]),
-               timing_s=timing, newton_iterations=its, newton_iterations_total=int(sum(its)),
-               converged=m["solver"].get("converged"), cutbacks=m["solver"].get("cutbacks"),
-               contact_half_width=a, peak_pressure=p0,
-               analytic=dict(contact_half_width=aH, peak_pressure=p0H), errors=errors)
+    rec = dict(variant=variant, path=study.variant_path(variant), h_divisor=divisor, h=h,
+               code_sha256=code_digest())
+    rec.update(study.run_hertz(h, VARIANTS[variant], timeout))
     return rec
-
-
-def loglog_rate(x, y):
-    """Least-squares slope of log y vs log x (None with fewer than 2 usable points)."""
-    pts = [(xi, yi) for xi, yi in zip(x, y) if xi > 0 and yi > 0]
-    if len({xi for xi, _ in pts}) < 2:
-        return None
-    lx, ly = np.log([p[0] for p in pts]), np.log([p[1] for p in pts])
-    slope = float(np.polyfit(lx, ly, 1)[0])
-    return slope
 
 
 def time_to_target(runs, target=TARGET):
@@ -213,15 +173,37 @@ def summarize(variant, runs):
     for k in ERRORS:
         errs = [r["errors"][k] for r in ok_h]
         rates[k] = loglog_rate(hs, errs)
-        monotone[k] = (all(b < a for a, b in zip(errs, errs[1:])) if len(errs) > 1
-                       else None)
-    return dict(variant=variant, runs_ok=len(ok), runs_failed=len(runs) - len(ok),
+        monotone[k] = study.decreasing(errs)
+    return dict(variant=variant, path=study.variant_path(variant), runs_ok=len(ok),
+                runs_failed=len(runs) - len(ok),
                 rates_vs_h=rates,
                 rate_pressure_l2_vs_dofs=loglog_rate([r["num_dofs"] for r in ok_h],
                                                       [r["errors"]["pressure_rel_l2_error"]
                                                        for r in ok_h]),
                 errors_decrease_monotonically=monotone,
                 time_to_target=time_to_target(ok))
+
+
+def compare_paths(summary):
+    """Time (and dofs) to TARGET of the cut variant(s) beside the fastest conforming variant."""
+    def best(path):
+        got = [(s["time_to_target"]["time_s"], v) for v, s in summary.items()
+               if s["path"] == path and s["time_to_target"]["reached"]]
+        return min(got) if got else (None, None)
+
+    (t_c, v_c), (t_x, v_x) = best("conforming"), best("cut")
+    return dict(
+        target=TARGET,
+        time_to_target_s={v: s["time_to_target"]["time_s"] for v, s in summary.items()},
+        dofs_at_target={v: s["time_to_target"]["num_dofs"] for v, s in summary.items()},
+        rate_pressure_l2_vs_h={v: s["rates_vs_h"]["pressure_rel_l2_error"]
+                               for v, s in summary.items()},
+        fastest_conforming=v_c, fastest_cut=v_x,
+        cut_over_conforming_time=(t_x / t_c if t_c and t_x else None),
+        definition="time_to_target_s: the demo's total time at which the pressure L2 error "
+                   "reaches the target (log-log interpolation, see summary.*.time_to_target); "
+                   "cut_over_conforming_time: fastest cut / fastest conforming (< 1: the cut "
+                   "path is faster)")
 
 
 def write_atomic(path, writer):
@@ -252,7 +234,7 @@ def write_json(path, data):
 
 
 COLORS = {"p1-tri": "tab:blue", "p2-tri": "tab:orange", "p1-quad": "tab:green",
-          "p2-quad": "tab:red"}
+          "p2-quad": "tab:red", "q1-cut": "tab:purple"}
 PHASE_COLORS = {"mesh": "tab:gray", "assembly": "tab:blue", "contact": "tab:orange",
                 "solve": "tab:green", "other": "whitesmoke"}
 
@@ -284,10 +266,11 @@ def plot(path, data):
             continue
         e = [100 * r["errors"]["pressure_rel_l2_error"] for r in ok]
         rate = data["summary"][v]["rates_vs_h"]["pressure_rel_l2_error"]
-        label = v + (f" (rate {rate:.2f} in h)" if rate is not None else "")
-        c = COLORS.get(v)
-        ax_t.loglog([r["timing_s"]["total"] for r in ok], e, "o-", color=c, label=label)
-        ax_n.loglog([r["num_dofs"] for r in ok], e, "o-", color=c, label=label)
+        label = (f"{v} ({'cut' if study.variant_path(v) == 'cut' else 'gmsh'})"
+                 + (f", rate {rate:.2f} in h" if rate is not None else ""))
+        c, style = COLORS.get(v), "s--" if study.variant_path(v) == "cut" else "o-"
+        ax_t.loglog([r["timing_s"]["total"] for r in ok], e, style, color=c, label=label)
+        ax_n.loglog([r["num_dofs"] for r in ok], e, style, color=c, label=label)
         for r, ei in zip(ok, e):
             ax_n.annotate(f"a/{r['h_divisor']}", (r["num_dofs"], ei), fontsize=7,
                           xytext=(3, 3), textcoords="offset points", color=c)
@@ -368,6 +351,16 @@ def report(data):
               f"p L2 {fmt(rt['pressure_rel_l2_error'], '.2f')}; "
               f"time to {100 * TARGET:g} %: "
               + (f"{tt['time_s']:.2f} s ({tt['method']})" if tt["reached"] else tt["method"]))
+    c = data["cut_vs_conforming"]
+    print(f"time to {100 * TARGET:g} % pressure L2 error, gmsh vs cut path:")
+    print(f"  {'variant':8} {'path':10} {'rate in h':>9} {'time s':>8} {'dofs':>8}")
+    for v, s in data["summary"].items():
+        tt = s["time_to_target"]
+        print(f"  {v:8} {s['path']:10} {fmt(s['rates_vs_h']['pressure_rel_l2_error'], '9.2f'):>9} "
+              f"{fmt(tt['time_s'], '8.2f'):>8} {fmt(tt['num_dofs'], '8.0f'):>8}")
+    if c["cut_over_conforming_time"] is not None:
+        print(f"  {c['fastest_cut']} / {c['fastest_conforming']}: "
+              f"{c['cut_over_conforming_time']:.2f} x the time")
 
 
 def main(argv=None):
@@ -412,6 +405,7 @@ def main(argv=None):
         runs=runs,
         summary={v: summarize(v, [r for r in runs if r["variant"] == v]) for v in args.variants},
     )
+    data["cut_vs_conforming"] = compare_paths(data["summary"])
     json_path, png_path = out_dir / "work_precision.json", out_dir / "work_precision.png"
     write_json(json_path, data)
     plot(png_path, data)

@@ -1,0 +1,100 @@
+"""demos/convergence_study.py: the JSON contract on 2 coarse cut runs (h = a/6, a/12, ~10 s),
+bad input, and the helper shared with benchmarks/work_precision.py."""
+
+import importlib.util
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DEMO = ROOT / "demos" / "convergence_study.py"
+
+
+def load(name, path):
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules.setdefault(name, mod)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def run(*args):
+    return subprocess.run([sys.executable, str(DEMO), *args], capture_output=True, text=True,
+                          cwd=ROOT)
+
+
+@pytest.fixture(scope="module")
+def study(tmp_path_factory):
+    out = tmp_path_factory.mktemp("convergence") / "cut"
+    r = run("--discretization", "cut", "--sizes", "12,6", "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    return out, json.loads((out / "convergence.json").read_text())
+
+
+def test_contract(study):
+    out, d = study
+    assert d["discretizations"] == ["cut"] and d["sizes"] == [6, 12]  # sorted coarse to fine
+    assert d["variants"] == {"cut": "q1-cut"}
+    assert d["hertz_args"]["cut"] == ["--discretization", "cut"]
+    assert abs(d["a_hertz"] - 0.99822) < 1e-4
+    assert [r["h_divisor"] for r in d["runs"]] == [6, 12]
+    for r in d["runs"]:
+        assert r["ok"] and r["discretization"] == "cut" and r["variant"] == "q1-cut"
+        assert abs(r["h"] - d["a_hertz"] / r["h_divisor"]) < 1e-12
+        assert r["hertz_parameters"]["discretization"] == "cut"
+        assert r["num_dofs"] > 0 and r["timing_s"]["total"] > 0
+        assert set(r["errors"]) == {"half_width_rel_error", "peak_pressure_rel_error",
+                                    "pressure_rel_l2_error"}
+        for f in ("metrics.json", "tractions.csv"):
+            assert (out / r["files"] / f).is_file()
+    assert (out / "convergence.png").stat().st_size > 0
+    s = d["summary"]["cut"]
+    assert s["runs_ok"] == 2 and s["runs_failed"] == 0
+    assert set(s) >= {"rates_vs_h", "local_rates_vs_h", "errors_decrease_monotonically", "check"}
+    assert len(s["local_rates_vs_h"]["pressure_rel_l2_error"]) == 1
+
+
+def test_errors_decrease(study):
+    _, d = study
+    s = d["summary"]["cut"]
+    coarse, fine = (r["errors"] for r in d["runs"])
+    # p(x) L2 error: 5.2 % -> 3.0 % at a/6 -> a/12 (rate ~0.8; ~1 from a/10 on)
+    assert fine["pressure_rel_l2_error"] < coarse["pressure_rel_l2_error"]
+    assert fine["peak_pressure_rel_error"] < coarse["peak_pressure_rel_error"]
+    assert s["errors_decrease_monotonically"]["pressure_rel_l2_error"] is True
+    assert 0.5 < s["rates_vs_h"]["pressure_rel_l2_error"] < 2.0
+    assert s["check"]["passed"] is True
+
+
+@pytest.mark.parametrize("args,name", [
+    (["--sizes", "10"], "--sizes"), (["--sizes", "10,10"], "--sizes"),
+    (["--sizes", "1,10"], "--sizes"), (["--sizes", "10,x"], "--sizes"),
+    (["--discretization", "p1"], "--discretization"), (["--timeout", "-1"], "--timeout")])
+def test_bad_input(tmp_path, args, name):
+    out = tmp_path / "never"
+    r = run(*args, "--out", str(out))
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and name in lines[0], r.stderr
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_out_is_a_file(tmp_path):
+    f = tmp_path / "file"
+    f.write_text("x")
+    r = run("--out", str(f))
+    assert r.returncode == 2 and "--out" in r.stderr and f.read_text() == "x"
+
+
+def test_work_precision_shares_the_runner():
+    cs = load("convergence_study", DEMO)
+    wp = load("work_precision", ROOT / "benchmarks" / "work_precision.py")
+    assert wp.study.run_hertz.__code__ is cs.run_hertz.__code__
+    assert wp.VARIANTS["q1-cut"] == ["--discretization", "cut"]
+    assert wp.parse([]).variants == ["p1-tri", "p1-quad", "q1-cut"]
+    assert wp.parse(["--quick"]).variants == ["p1-tri", "q1-cut"]
+    assert cs.loglog_rate([1, 2, 4], [1, 4, 16]) == pytest.approx(2.0)
+    assert cs.loglog_rate([1, 1], [1, 2]) is None
