@@ -244,9 +244,10 @@ def plain_log_labels(ax):
     from matplotlib.ticker import FuncFormatter, NullFormatter
 
     fmt = FuncFormatter(lambda v, _: f"{v:g}")
-    for axis, (lo, hi) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+    # x labels are wide: beyond a span of 6 the minor ones overlap (y: beyond 30)
+    for axis, (lo, hi), span in ((ax.xaxis, ax.get_xlim(), 6), (ax.yaxis, ax.get_ylim(), 30)):
         axis.set_major_formatter(fmt)
-        short = lo > 0 and hi / lo < 30
+        short = lo > 0 and hi / lo < span
         axis.set_minor_formatter(fmt if short else NullFormatter())
 
 
@@ -315,6 +316,7 @@ def plot(path, data):
         x += 0.8
     ax_s.set_xticks(pos)
     ax_s.set_xticklabels(labels, fontsize=7)
+    ax_s.set_ylim(0, 1.12 * ax_s.get_ylim()[1])  # room for the totals above the bars
     ax_s.set_ylabel("wall time (s)")
     ax_s.set_title("phase times per run (other: total minus the four phases)")
     if bottoms_seen:
