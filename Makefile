@@ -8,7 +8,7 @@ PYTHON  ?= /usr/bin/python3
 BUILD   ?= build
 OUT     ?= results
 JOBS    ?= 2
-APT_PACKAGES := cmake make gcc g++ python3-dolfinx libdolfinx-dev python3-gmsh gmsh \
+APT_PACKAGES := cmake make gcc g++ python3-sympy python3-dolfinx libdolfinx-dev python3-gmsh gmsh \
 	libeigen3-dev python3-mpi4py python3-meshio pybind11-dev python3-pytest \
 	python3-scipy python3-matplotlib libgtest-dev libbenchmark-dev python3-setuptools \
 	python3-venv openmpi-bin

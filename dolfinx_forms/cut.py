@@ -29,8 +29,10 @@ from . import _cpp
 
 LAYOUT = _cpp.cut_layout()
 KERNELS = _cpp.cut_kernels()
-# kind_tags values = integral ids of the cell integrals; ghost-facet tag = interior-facet id
-from meshes.cut import CUT, GHOST_FACET as GHOST, INTERIOR  # noqa: E402
+# kind_tags values = integral ids of the cell integrals; ghost-facet tag = interior-facet id.
+# One source of truth: the scene builders (meshes.cut) import these.
+INTERIOR, CUT = 0, 1
+GHOST_FACET = GHOST = 1
 _TYPES = {0: _dcpp.fem.IntegralType.cell, 1: _dcpp.fem.IntegralType.exterior_facet,
           2: _dcpp.fem.IntegralType.interior_facet}
 
@@ -68,6 +70,21 @@ def _mixed_form(ufl_form, replace, subdomains):
     return form, module
 
 
+def levelset_values(scene, V):
+    """A Function on the scalar Q1 space V of scene.mesh holding at each dof the cut shape of the
+    body owning it (the bodies are disjoint: every dof belongs to one body); ghosts updated."""
+    phi = fem.Function(V)
+    ncells = len(scene.cell_tags.values)
+    cell_dofs = V.dofmap.list.array.reshape(ncells, -1)
+    xdof = V.tabulate_dof_coordinates()[:, :2]
+    for tag, shape in scene.cut.levelsets.items():
+        dofs = np.unique(cell_dofs[scene.cell_tags.values == tag])
+        if len(dofs):
+            phi.x.array[dofs] = np.asarray(shape(np.ascontiguousarray(xdof[dofs])))
+    phi.x.scatter_forward()
+    return phi
+
+
 def _check_layout(form, names):
     got = [c.name for c in form.coefficients]
     if got[:len(names)] != names:
@@ -79,7 +96,7 @@ class CutForms:
     """Bulk forms of a cut scene for vector Q1 space V (see the module docstring).
 
     materials: {body tag: (E, nu)}; ghost_penalty: gamma (0 switches it off); phi: a scalar Q1
-    Function of the level sets (default: `meshes.cut.levelset_values` of the scene), created
+    Function of the level sets (default: `levelset_values` of the scene), created
     before this object (coefficient order)."""
 
     def __init__(self, V, scene, materials, ghost_penalty=0.01, phi=None):
@@ -92,8 +109,6 @@ class CutForms:
         self.gamma = float(ghost_penalty)
         # coefficients in kernel-layout order: phi first (created first), then cell data
         if phi is None:
-            from meshes.cut import levelset_values
-
             phi = levelset_values(scene, fem.FunctionSpace(mesh, ("Lagrange", 1)))
         self.phi = phi
         self.phi.name = "phi"

@@ -35,6 +35,7 @@ import dolfinx.fem
 import dolfinx.mesh
 import numpy as np
 import ufl
+from dolfinx_forms.cut import CUT, GHOST_FACET, INTERIOR, levelset_values  # noqa: F401
 
 from .hertz import hertz_contact_box
 from .scene import Body, Scene, contact_partitioner, on_box_side, summary, tag_boundaries
@@ -43,8 +44,6 @@ __all__ = ["CutBody", "CutData", "graded_lines", "half_plane", "cut_scene", "lev
            "hertz_cut_scene", "patch_cut_scene", "two_blocks_cut_scene", "incline_cut_scene",
            "cut_counts", "INTERIOR", "CUT"]
 
-INTERIOR, CUT = 0, 1  # CutData.kind_tags values
-GHOST_FACET = 1  # CutData.ghost_facets value
 
 
 # --------------------------------------------------------------------------- grid lines
@@ -294,21 +293,6 @@ def cut_scene(comm, xlines, ylines, bodies, boundary_markers, pairs, h_contact, 
     return Scene(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, boundaries=boundaries,
                  bodies=scene_bodies, pairs=[tuple(p) for p in pairs], h_contact=float(h_contact),
                  cell_type="quadrilateral", cut=cut)
-
-
-def levelset_values(scene: Scene, V) -> dolfinx.fem.Function:
-    """A Function on the scalar Q1 space V of scene.mesh holding at each dof the cut shape of the
-    body owning it (the bodies are disjoint: every dof belongs to one body); ghosts updated."""
-    phi = dolfinx.fem.Function(V)
-    ncells = len(scene.cell_tags.values)
-    cell_dofs = V.dofmap.list.array.reshape(ncells, -1)
-    xdof = V.tabulate_dof_coordinates()[:, :2]
-    for tag, shape in scene.cut.levelsets.items():
-        dofs = np.unique(cell_dofs[scene.cell_tags.values == tag])
-        if len(dofs):
-            phi.x.array[dofs] = np.asarray(shape(np.ascontiguousarray(xdof[dofs])))
-    phi.x.scatter_forward()
-    return phi
 
 
 # --------------------------------------------------------------------------- generators
