@@ -76,7 +76,7 @@ from dolfinx_forms.cli import (DemoParser, add_discretization, bounded,  # noqa:
 from dolfinx_forms.output import atomic_output, finish, gather_points, plot_tractions  # noqa: E402
 from dolfinx_forms.results import PhaseTimer, new_metrics  # noqa: E402
 from dolfinx_forms.solver import (ContactProblem, ContactSolverError, Dirichlet,  # noqa: E402
-                                  Traction, plane_strain, solver_metrics, zone_ends)
+                                  Traction, solver_metrics, zone_ends)
 from meshes.cut import cut_counts, two_blocks_cut_scene  # noqa: E402
 from meshes.two_blocks import two_blocks_scene  # noqa: E402
 
@@ -204,18 +204,8 @@ def sigma_x_line(problem, y, xs, body=0):
     mesh, scene = problem.mesh, problem.scene
     pts = np.column_stack([xs, np.full_like(xs, y), np.zeros_like(xs)])
     family = "DQ" if scene.cell_type == "quadrilateral" else "DG"
-    Q0 = fem.FunctionSpace(mesh, (family, 0))  # Lame parameters per cell
-    lam_mu = [fem.Function(Q0) for _ in range(2)]
-    q0 = Q0.dofmap.list.array
-    for tag, (E, nu) in problem.materials.items():
-        cells = scene.cell_tags.find(tag)
-        for f, v in zip(lam_mu, plane_strain(E, nu)):
-            f.x.array[q0[cells]] = v
-    Q = fem.FunctionSpace(mesh, (family, 1))
-    e = ufl.sym(ufl.grad(problem.u))
-    sig = fem.Function(Q)
-    sig.interpolate(fem.Expression(2 * lam_mu[0] * e[0, 0] + lam_mu[1] * ufl.tr(e),
-                                   Q.element.interpolation_points()))
+    sig = problem.stress((family, 1))  # the laws' stress, cellwise (DG/DQ 1) tensor
+    Q = sig.function_space
     # vertex average over the body's owned cells (sums and counts added across ranks)
     V1 = fem.FunctionSpace(mesh, ("Lagrange", 1))
     n_owned = mesh.topology.index_map(mesh.topology.dim).size_local
@@ -226,7 +216,8 @@ def sigma_x_line(problem, y, xs, body=0):
     cg = V1.dofmap.list.array.reshape(-1, nv)[mine]
     assert np.allclose(Q.tabulate_dof_coordinates()[dq], V1.tabulate_dof_coordinates()[cg])
     total, count = fem.Function(V1), fem.Function(V1)
-    total.x.array[:] = np.bincount(cg.ravel(), sig.x.array[dq].ravel(), len(total.x.array))
+    sxx = sig.x.array.reshape(-1, 4)[:, 0]  # blocked dofs: (xx, xy, yx, yy) per node
+    total.x.array[:] = np.bincount(cg.ravel(), sxx[dq].ravel(), len(total.x.array))
     count.x.array[:] = np.bincount(cg.ravel(), None, len(count.x.array))
     for f in (total, count):
         f.x.scatter_reverse(la.ScatterMode.add)

@@ -1,25 +1,26 @@
-"""Cut-cell forms: FFCx kernels on interior cells, C++ kernels on cut cells, in ONE dolfinx Form.
+"""Cut-cell integration: any UFL integrand on the inside part of cut cells, in dolfinx Forms.
 
 A cut scene (`meshes.cut`) holds the active cells of every body on a structured grid, tagged
-interior (0) or cut (1), and the interior facets of cut cells (ghost-penalty facets). Here
+interior (0) or cut (1), and the interior facets of cut cells (ghost-penalty facets).
 
-* bilinear form: plane-strain elasticity, integral id 0 on interior cells is the FFCx kernel of
-  the UFL form, id 1 on cut cells is `contact::cut::elasticity_q1` (the cell split by the
-  straight zero contour of phi, the inside part triangulated, a degree-2 rule per triangle:
-  exact for Q1 on the grid's rectangles); the ghost penalty (eq. below) is an FFCx interior-facet
-  integral of the same Form;
-* traction forms: FFCx on boundary facets of interior cells, `contact::cut::traction_q1` (the
-  facet clipped by phi, the traction interpolated in vector Q2) on facets of cut cells.
-
-Ghost penalty (Burman 2010) on the faces F of cut cells, Q1: gamma * (2 mu + lambda) * h_n *
-int_F [grad u . n] . [grad v . n], with h_n the cell width normal to F. It vanishes on linear
-fields (patch test untouched) and bounds the condition number as cut fractions go to zero.
-
-The kernels read their coefficients at fixed offsets (`_cpp.cut_layout()`, defined in
-`contact/cut_cell.h`): phi (vertex values) first, then the cell data. The forms below are built
-so that FFCx packs them in that order, and `_check_layout` verifies it.
+* Cell integrals (any UFL law, body force, energy): on interior cells FFCx's own rule; on cut
+  cells FFCx's tensor Gauss rule of degree `degree` (m = (degree + 2) // 2 points per direction)
+  with per-point factors held by a `Quadrature`-element coefficient. The factors make the
+  effective weights the moment-fitted weights of the inside part {phi_h < 0} (C++
+  `contact::cut::moment_fitted_weights`): exact for every integrand in Q_{m-1}, i.e. for
+  Q1 elasticity on the grid's rectangles (integrand in Q2) with the default degree 4. The
+  user's form is compiled by FFCx unchanged; history variables can live at the same points.
+  `CutIntegration.measure(tag)` is the measure: `integrand * measure` gives both parts.
+* Ghost penalty (Burman 2010) on the faces F of cut cells, Q1: gamma * p_modulus * h_n *
+  int_F [grad u . n] . [grad v . n], with h_n the cell width normal to F. It vanishes on linear
+  fields (patch test untouched) and bounds the condition number as cut fractions go to zero.
+* Traction forms: FFCx on boundary facets of interior cells, `contact::cut::traction_q1` (the
+  facet clipped by phi, the traction interpolated in vector Q2) on facets of cut cells. That
+  kernel reads its coefficients at fixed offsets (`_cpp.cut_layout()`, from
+  `contact/cut_cell.h`): phi (vertex values) first, then the traction; `_check_layout` checks.
 """
 
+import basix
 import numpy as np
 import ufl
 from dolfinx import cpp as _dcpp
@@ -29,10 +30,11 @@ from . import _cpp
 
 LAYOUT = _cpp.cut_layout()
 KERNELS = _cpp.cut_kernels()
-# kind_tags values = integral ids of the cell integrals; ghost-facet tag = interior-facet id.
-# One source of truth: the scene builders (meshes.cut) import these.
+# kind_tags values; ghost-facet tag = interior-facet id. One source of truth: the scene
+# builders (meshes.cut) import these. Cell-integral ids: body tag + CUT_ID * kind.
 INTERIOR, CUT = 0, 1
 GHOST_FACET = GHOST = 1
+CUT_ID = 1000
 _TYPES = {0: _dcpp.fem.IntegralType.cell, 1: _dcpp.fem.IntegralType.exterior_facet,
           2: _dcpp.fem.IntegralType.interior_facet}
 
@@ -92,61 +94,90 @@ def _check_layout(form, names):
                            f"{names} first (contact/cut_cell.h Layout)")
 
 
-class CutForms:
-    """Bulk forms of a cut scene for vector Q1 space V (see the module docstring).
+class BodyMeasure:
+    """`integrand * BodyMeasure` = the integral over the bodies' material: interior cells with
+    FFCx's rule, cut cells with the moment-fitted weights (a sum of UFL forms)."""
 
-    materials: {body tag: (E, nu)}; ghost_penalty: gamma (0 switches it off); phi: a scalar Q1
-    Function of the level sets (default: `levelset_values` of the scene), created
-    before this object (coefficient order)."""
+    def __init__(self, parts):
+        self.parts = parts  # [(ufl Measure, factor or None)]
 
-    def __init__(self, V, scene, materials, ghost_penalty=0.01, phi=None):
-        from .solver import plane_strain
+    def __rmul__(self, integrand):
+        form = 0
+        for dx, factor in self.parts:
+            form += (integrand if factor is None else integrand * factor) * dx
+        return form
 
-        if V.ufl_element().degree() != 1 or scene.cell_type != "quadrilateral":
-            raise ValueError("degree: the cut path supports Q1 (degree 1) on quadrilaterals only")
-        self.V, self.scene, self.mesh = V, scene, scene.mesh
-        cut, mesh = scene.cut, scene.mesh
-        self.gamma = float(ghost_penalty)
-        # coefficients in kernel-layout order: phi first (created first), then cell data
-        if phi is None:
-            phi = levelset_values(scene, fem.FunctionSpace(mesh, ("Lagrange", 1)))
-        self.phi = phi
+
+class CutIntegration:
+    """Measures, ghost penalty and traction forms of a cut scene (see the module docstring).
+
+    degree: FFCx quadrature degree on cut cells (4: 3x3 Gauss points, exact for Q2
+    integrands over the inside part); phi: a scalar Q1 Function of the level sets (default
+    `levelset_values` of the scene), created before any form that uses `traction_form`."""
+
+    def __init__(self, scene, degree=4, phi=None):
+        if scene.cell_type != "quadrilateral":
+            raise ValueError("cut integration: quadrilateral cells only")
+        self.scene, self.mesh, self.degree = scene, scene.mesh, int(degree)
+        mesh, cut = scene.mesh, scene.cut
+        self.phi = phi if phi is not None else levelset_values(
+            scene, fem.FunctionSpace(mesh, ("Lagrange", 1)))
         self.phi.name = "phi"
-        D = fem.VectorFunctionSpace(mesh, ("DG", 0), dim=4)
-        self.cell_data = fem.Function(D, name="cell_data")  # (mu, lambda, hx, hy) per cell
-        data = self.cell_data.x.array.reshape(-1, 4)
-        ddofs = D.dofmap.list.array
-        for tag, (E, nu) in materials.items():
-            cells = scene.cell_tags.indices[scene.cell_tags.values == tag]
-            data[ddofs[cells], 0], data[ddofs[cells], 1] = plane_strain(E, nu)
-        x = mesh.geometry.x
-        g = mesh.geometry.dofmap.array.reshape(-1, 4)
-        data[ddofs[np.arange(len(g))], 2:] = np.ptp(x[g][:, :, :2], axis=1)  # grid cells
-        self.cell_data.x.scatter_forward()
-
-        u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-        mu, lmb, hx, hy = (self.cell_data[k] for k in range(4))
-        eps = lambda w: ufl.sym(ufl.grad(w))  # noqa: E731
-        sig = 2 * mu * eps(u) + lmb * ufl.tr(eps(u)) * ufl.Identity(2)
-        dx = ufl.Measure("dx", domain=mesh, subdomain_data=cut.kind_tags)
-        # the dx(CUT) integrand only makes FFCx pack phi; its kernel is replaced by C++
-        a = ufl.inner(sig, eps(v)) * dx(INTERIOR) + self.phi * ufl.inner(sig, eps(v)) * dx(CUT)
-        if self.gamma > 0:
-            n = ufl.FacetNormal(mesh)
-            dS = ufl.Measure("dS", domain=mesh, subdomain_data=cut.ghost_facets)
-            h_n = ufl.avg(abs(n[0]) * hx + abs(n[1]) * hy)  # cell width across the face
-            a += (self.gamma * ufl.avg(2 * mu + lmb) * h_n
-                  * ufl.inner(ufl.jump(ufl.grad(u), n), ufl.jump(ufl.grad(v), n)) * dS(GHOST))
-        self.a, self._module = _mixed_form(
-            a, {(0, CUT): KERNELS["elasticity_q1"]},
-            {0: cut.kind_tags, 1: None, 2: cut.ghost_facets})
-        _check_layout(self.a, ["phi", "cell_data"])
+        # one cell-integral id per (body, kind)
+        ncells = len(scene.cell_tags.values)
+        kind = np.zeros(ncells, np.int32)
+        kind[cut.kind_tags.indices] = cut.kind_tags.values
+        body = np.zeros(ncells, np.int32)
+        body[scene.cell_tags.indices] = scene.cell_tags.values
+        self.cell_ids = _dcpp.mesh.MeshTags_int32(
+            mesh._mesh, 2, np.arange(ncells, dtype=np.int32), body + CUT_ID * kind)
+        # moment-fitted weights on cut cells, as factors on FFCx's Gauss weights
+        points, wref = basix.make_quadrature(basix.CellType.quadrilateral, self.degree)
+        Qe = ufl.FiniteElement("Quadrature", mesh.ufl_cell(), self.degree, quad_scheme="default")
+        self.factor = fem.Function(fem.FunctionSpace(mesh, Qe), name="cut_weight_factor")
+        qdofs = self.factor.function_space.dofmap.list.array.reshape(ncells, -1)
+        pdofs = self.phi.function_space.dofmap.list.array.reshape(ncells, 4)
+        cells = np.flatnonzero(kind == CUT)
+        f = self.factor.x.array
+        f[:] = 1.0
+        if len(cells):
+            W = _cpp.cut_moment_weights(np.ascontiguousarray(self.phi.x.array[pdofs[cells]]),
+                                        np.ascontiguousarray(points))
+            f[qdofs[cells]] = W / wref
+        self.kind = kind
+        self.num_cut_cells = len(cells)
         self._keep = []
 
-    def insert_ghost_couplings(self, pattern):
+    def measure(self, tags=None):
+        """The measure over the material of the bodies `tags` (a tag, a list, or None: all)."""
+        bodies = sorted(set(self.scene.cell_tags.values)) if tags is None else np.atleast_1d(tags)
+        dx = ufl.Measure("dx", domain=self.mesh, subdomain_data=self.cell_ids)
+        dxq = ufl.Measure("dx", domain=self.mesh, subdomain_data=self.cell_ids,
+                          metadata={"quadrature_degree": self.degree})
+        ids = [int(t) for t in bodies]
+        return BodyMeasure([(dx(tuple(ids)), None),
+                            (dxq(tuple(t + CUT_ID for t in ids)), self.factor)])
+
+    def ghost_penalty(self, u, v, gamma, p_modulus):
+        """gamma p_modulus h_n [grad u . n][grad v . n] on the ghost facets (a UFL form);
+        p_modulus: a DG0 Function (stiffness across a face per cell)."""
+        mesh = self.mesh
+        D = fem.VectorFunctionSpace(mesh, ("DG", 0), dim=2)
+        hxy = fem.Function(D, name="cell_size")  # grid cells: widths in x and y
+        x = mesh.geometry.x
+        g = mesh.geometry.dofmap.array.reshape(-1, 4)
+        ddofs = D.dofmap.list.array
+        hxy.x.array.reshape(-1, 2)[ddofs[np.arange(len(g))]] = np.ptp(x[g][:, :, :2], axis=1)
+        hxy.x.scatter_forward()
+        self._keep.append(hxy)
+        n = ufl.FacetNormal(mesh)
+        dS = ufl.Measure("dS", domain=mesh, subdomain_data=self.scene.cut.ghost_facets)
+        h_n = ufl.avg(abs(n[0]) * hxy[0] + abs(n[1]) * hxy[1])  # cell width across the face
+        return (gamma * ufl.avg(p_modulus) * h_n
+                * ufl.inner(ufl.jump(ufl.grad(u), n), ufl.jump(ufl.grad(v), n)) * dS(GHOST))
+
+    def insert_ghost_couplings(self, pattern, V):
         """Add the cell-pair couplings of the ghost-penalty facets to a SparsityPattern."""
-        if self.gamma <= 0:
-            return
         top = self.mesh.topology
         top.create_connectivity(1, 2)
         f2c = top.connectivity(1, 2)
@@ -154,10 +185,10 @@ class CutForms:
         if len(facets) == 0:
             return
         cells = np.array([f2c.links(f) for f in facets])  # two cells per interior facet
-        dofs = self.V.dofmap.list.array.reshape(-1, 4)
+        dofs = V.dofmap.list.array.reshape(-1, 4)
         _cpp.insert_blocks(pattern, np.hstack([dofs[cells[:, 0]], dofs[cells[:, 1]]]))
 
-    def traction_form(self, traction, boundary_tag):
+    def traction_form(self, V, traction, boundary_tag):
         """Linear form int t . v ds over the facets tagged `boundary_tag`; on facets of cut
         cells only their inside part (t interpolated in vector Q2 there)."""
         mesh, scene = self.mesh, self.scene
@@ -165,15 +196,13 @@ class CutForms:
         top = mesh.topology
         top.create_connectivity(1, 2)
         f2c = top.connectivity(1, 2)
-        kind = np.zeros(top.index_map(2).size_local + top.index_map(2).num_ghosts, np.int32)
-        kind[scene.cut.kind_tags.indices] = scene.cut.kind_tags.values
         cells = f2c.array[f2c.offsets[facets]]
         tags = _dcpp.mesh.MeshTags_int32(mesh._mesh, 1, facets.astype(np.int32),
-                                         kind[cells].astype(np.int32))
+                                         self.kind[cells].astype(np.int32))
         V2 = fem.VectorFunctionSpace(mesh, ("Lagrange", 2))
         t_h = fem.Function(V2, name="traction")
         t_h.interpolate(fem.Expression(traction, V2.element.interpolation_points()))
-        v = ufl.TestFunction(self.V)
+        v = ufl.TestFunction(V)
         ds = ufl.Measure("ds", domain=mesh, subdomain_data=tags)
         L = ufl.inner(traction, v) * ds(INTERIOR) + self.phi * ufl.inner(t_h, v) * ds(CUT)
         form, module = _mixed_form(L, {(1, CUT): KERNELS["traction_q1"]}, {0: None, 1: tags, 2: None})

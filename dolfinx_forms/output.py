@@ -7,7 +7,7 @@ import numpy as np
 
 from .results import atomic_output_dir as atomic_output  # noqa: F401 (demos use it)
 from .results import write_metrics
-from .solver import STATE_NAMES
+from .contact_set import STATE_NAMES
 
 TRACTION_COLUMNS = ("x", "y", "p_n", "p_t", "gap_n", "slip", "state")
 
@@ -37,27 +37,13 @@ def write_tractions(folder, pts):
 
 def write_fields(folder, problem, name="solution"):
     """Displacement (P1) and Cauchy stress (cellwise constant) in XDMF for ParaView."""
-    import ufl
     from dolfinx import fem, io
 
     mesh = problem.mesh
     V1 = fem.VectorFunctionSpace(mesh, ("Lagrange", 1))
     u1 = fem.Function(V1, name="displacement")
     u1.interpolate(problem.u)
-    S = fem.TensorFunctionSpace(mesh, ("DG", 0))
-    sig = fem.Function(S, name="stress")
-    Q = fem.FunctionSpace(mesh, ("DG", 0))
-    lam_mu = [fem.Function(Q) for _ in range(2)]
-    for tag, (E, nu) in problem.materials.items():
-        cells = problem.scene.cell_tags.find(tag)
-        from .solver import plane_strain
-        m, lmb = plane_strain(E, nu)
-        lam_mu[0].x.array[cells] = m
-        lam_mu[1].x.array[cells] = lmb
-    e = ufl.sym(ufl.grad(problem.u))
-    expr = fem.Expression(2 * lam_mu[0] * e + lam_mu[1] * ufl.tr(e) * ufl.Identity(2),
-                          S.element.interpolation_points())
-    sig.interpolate(expr)
+    sig = problem.stress(("DG", 0))  # the laws' own output stress
     with io.XDMFFile(mesh.comm, str(Path(folder) / f"{name}.xdmf"), "w") as f:
         f.write_mesh(mesh)
         f.write_function(u1)

@@ -1,6 +1,8 @@
 // Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
 #include "cut_cell.h"
 #include <cmath>
+#include <numbers>
+#include <stdexcept>
 
 namespace contact::cut {
 namespace {
@@ -16,8 +18,10 @@ const TriangleRule& triangle_rule(int degree) {
   static const TriangleRule r1{1, {1.0 / 3}, {1.0 / 3}, {1.0}};
   static const TriangleRule r2{
       3, {1.0 / 6, 2.0 / 3, 1.0 / 6}, {1.0 / 6, 1.0 / 6, 2.0 / 3}, {1.0 / 3, 1.0 / 3, 1.0 / 3}};
-  constexpr double a = 0.445948490915965, b = 0.091576213509771;
-  constexpr double wa = 0.223381589678011, wb = 0.109951743655322;
+  // Full double precision: the moment-fitted weights rely on this rule being exact to
+  // round-off (15-digit constants leave the weights' sum 1e-15 off).
+  constexpr double a = 0.44594849091596488632, b = 0.091576213509770743460;
+  constexpr double wa = 0.22338158967801146570, wb = 0.10995174365532186764;
   static const TriangleRule r4{6,
                                {a, 1 - 2 * a, a, b, 1 - 2 * b, b},
                                {a, a, 1 - 2 * a, b, b, 1 - 2 * b},
@@ -42,6 +46,54 @@ void q1_gradients(double X, double Y, double dX[4], double dY[4]) {
 
 /// Facet -> its two vertices (DOLFINx quadrilateral).
 constexpr std::array<std::array<int, 2>, 4> facet_vertices = {{{0, 1}, {0, 2}, {1, 3}, {2, 3}}};
+
+struct GaussRule {
+  std::array<double, max_fitted_points> x, w; // on [0, 1], weights sum to 1
+};
+
+/// Gauss-Legendre rule on [0, 1] with n = 1..max_fitted_points points (Newton on P_n, once).
+const GaussRule& gauss_legendre(int n) {
+  static const std::array<GaussRule, max_fitted_points> rules = [] {
+    std::array<GaussRule, max_fitted_points> r{};
+    for (int np = 1; np <= max_fitted_points; ++np)
+      for (int i = 0; i < np; ++i) {
+        double z = std::cos(std::numbers::pi * (i + 0.75) / (np + 0.5)), dp = 1;
+        for (int it = 0; it < 100; ++it) {
+          double p = 1, p_prev = 0; // P_np(z) by the three-term recurrence
+          for (int j = 1; j <= np; ++j) {
+            const double p_next = ((2 * j - 1) * z * p - (j - 1) * p_prev) / j;
+            p_prev = p, p = p_next;
+          }
+          dp = np * (z * p - p_prev) / (z * z - 1);
+          const double dz = p / dp;
+          z -= dz;
+          if (std::abs(dz) < 1e-16)
+            break;
+        }
+        r[np - 1].x[i] = 0.5 * (1 - z);
+        r[np - 1].w[i] = 1 / ((1 - z * z) * dp * dp);
+      }
+    return r;
+  }();
+  return rules[n - 1];
+}
+
+/// Calls f(xi, eta, w) for the points of a rule on the reference triangle exact for total
+/// `degree` (weights sum to 1): Dunavant up to degree 4, above it collapsed (Duffy) Gauss,
+/// xi = u, eta = v (1 - u), whose Jacobian 1 - u raises the degree in u by one.
+template <typename F> void for_each_triangle_point(int degree, F f) {
+  if (degree <= 4) {
+    const TriangleRule& r = triangle_rule(degree);
+    for (int q = 0; q < r.n; ++q)
+      f(r.xi[q], r.eta[q], r.w[q]);
+    return;
+  }
+  const int n = (degree + 3) / 2; // exact to 2n - 1 in u, i.e. total degree 2n - 2
+  const GaussRule& g = gauss_legendre(n);
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b)
+      f(g.x[a], g.x[b] * (1 - g.x[a]), 2 * g.w[a] * g.w[b] * (1 - g.x[a]));
+}
 } // namespace
 
 int clip_square(std::span<const double, 4> phi, std::span<double, 6 * max_triangles> tri) {
@@ -126,6 +178,84 @@ double inside_fraction(std::span<const double, 4> phi) {
   for (int k = 0; k < nt; ++k)
     s += area(tri.data() + 6 * k);
   return s;
+}
+
+void moment_fitted_weights(std::span<const double, 4> phi, std::span<const double> points,
+                           std::span<double> weights) {
+  constexpr int mmax = max_fitted_points;
+  const std::size_t nq = points.size() / 2;
+  if (points.size() % 2 != 0 or nq == 0)
+    throw std::invalid_argument("moment_fitted_weights: points must hold nq > 0 (X, Y) pairs");
+  if (weights.size() != nq)
+    throw std::invalid_argument("moment_fitted_weights: weights must have one entry per point");
+  if (nq > std::size_t(mmax * mmax))
+    throw std::invalid_argument("moment_fitted_weights: at most 6 x 6 points");
+
+  // Recover the grid lines of each direction and the grid position (i, j) of each point.
+  constexpr double tol = 1e-10;
+  std::array<std::array<double, mmax>, 2> nodes;
+  std::array<int, 2> m = {0, 0};
+  std::array<std::array<int, mmax * mmax>, 2> pos;
+  for (std::size_t k = 0; k < nq; ++k)
+    for (int d = 0; d < 2; ++d) {
+      const double x = points[2 * k + d];
+      int i = 0;
+      while (i < m[d] and std::abs(x - nodes[d][i]) > tol)
+        ++i;
+      if (i == m[d]) {
+        if (m[d] == mmax)
+          throw std::invalid_argument(
+              "moment_fitted_weights: more than 6 distinct coordinates in a direction");
+        nodes[d][m[d]++] = x;
+      }
+      pos[d][k] = i;
+    }
+  // nq == mx * my distinct positions: the full grid (pigeonhole)
+  if (std::size_t(m[0] * m[1]) != nq)
+    throw std::invalid_argument("moment_fitted_weights: points do not form a full tensor grid");
+  std::array<bool, mmax * mmax> seen{};
+  for (std::size_t k = 0; k < nq; ++k) {
+    bool& s = seen[pos[0][k] * m[1] + pos[1][k]];
+    if (s)
+      throw std::invalid_argument("moment_fitted_weights: points do not form a full tensor grid");
+    s = true;
+  }
+
+  std::array<std::array<double, mmax>, 2> denom; // Lagrange denominators prod (x_i - x_j)
+  for (int d = 0; d < 2; ++d)
+    for (int i = 0; i < m[d]; ++i) {
+      denom[d][i] = 1;
+      for (int j = 0; j < m[d]; ++j)
+        if (j != i)
+          denom[d][i] *= nodes[d][i] - nodes[d][j];
+    }
+
+  // Moments of the tensor Lagrange polynomials l_i(X) l_j(Y) over the inside part; their
+  // product has degree (mx - 1) + (my - 1), integrated exactly on each sub-triangle.
+  std::array<double, mmax * mmax> M{};
+  std::array<double, 6 * max_triangles> tri;
+  const int nt = clip_square(phi, tri);
+  for (int t = 0; t < nt; ++t) {
+    const double* v = tri.data() + 6 * t;
+    const double A = area(v);
+    for_each_triangle_point(m[0] + m[1] - 2, [&](double xi, double eta, double w) {
+      const double x[2] = {v[0] + xi * (v[2] - v[0]) + eta * (v[4] - v[0]),
+                           v[1] + xi * (v[3] - v[1]) + eta * (v[5] - v[1])};
+      std::array<std::array<double, mmax>, 2> l;
+      for (int d = 0; d < 2; ++d)
+        for (int i = 0; i < m[d]; ++i) {
+          l[d][i] = 1 / denom[d][i];
+          for (int j = 0; j < m[d]; ++j)
+            if (j != i)
+              l[d][i] *= x[d] - nodes[d][j];
+        }
+      for (int i = 0; i < m[0]; ++i)
+        for (int j = 0; j < m[1]; ++j)
+          M[i * m[1] + j] += A * w * l[0][i] * l[1][j];
+    });
+  }
+  for (std::size_t k = 0; k < nq; ++k)
+    weights[k] = M[pos[0][k] * m[1] + pos[1][k]];
 }
 
 void elasticity_q1(double* A, const double* w, const double*, const double* x, const int*,

@@ -56,6 +56,28 @@ std::array<double, 2> clip_segment(double phi0, double phi1);
 /// @brief Area fraction of the inside part of the reference square (0..1).
 double inside_fraction(std::span<const double, 4> phi);
 
+/// Largest number of points per direction that `moment_fitted_weights` accepts.
+constexpr int max_fitted_points = 6;
+
+/// @brief Moment-fitted weights of a fixed tensor rule on a cut cell (cut-cell integration of
+/// the ILS-MPM paper, section 4.2, for any integrand).
+///
+/// The points (e.g. FFCx's tensor Gauss rule) stay where they are; only the weights change, so
+/// that sum_k W_k p(X_k) = int_{inside} p for every p in Q_{mx-1} x Q_{my-1}. W_k is the integral
+/// over the inside part (exactly the triangles of `clip_square`) of the tensor Lagrange
+/// polynomial of point k, computed with a triangle rule exact for degree mx + my - 2. The weights
+/// can be negative, but they integrate Q_{m-1} exactly: with m = 3 the elastic energy of Q1 fields
+/// (in Q2 on rectangles) is exact and so stays positive semi-definite. A fully inside cell gives
+/// the tensor Gauss weights (to round-off), a fully outside cell zeros.
+/// @param phi level-set values at the 4 vertices (tensor order)
+/// @param points nq reference points (X, Y interleaved) forming a full tensor grid of
+///   mx x my points in any order (coordinates equal to 1e-10 count as one grid line),
+///   1 <= mx, my <= `max_fitted_points`
+/// @param weights output (nq): weights in the order of `points` (the full square has total 1)
+/// @throws std::invalid_argument if the points are not a full tensor grid or sizes mismatch
+void moment_fitted_weights(std::span<const double, 4> phi, std::span<const double> points,
+                           std::span<double> weights);
+
 /// @brief Cut-cell plane-strain elasticity matrix of a vector Q1 quadrilateral (ufcx ABI).
 ///
 /// A (8x8, row-major, dof = node*2 + component) += int_{cell, phi_h<0} 2 mu eps(u):eps(v) +

@@ -67,6 +67,24 @@ void bind_cut(py::module_& m) {
       },
       py::arg("phi"), "Inside area fraction of each cell, phi (n, 4) in tensor order");
   m.def(
+      "cut_moment_weights",
+      [](const carray& phi, const carray& points) {
+        const auto p = as_span(phi, "phi", 4);
+        const auto x = as_span(points, "points", 2);
+        const std::size_t n = p.size() / 4, nq = x.size() / 2;
+        if (nq == 0)
+          throw std::invalid_argument("points: expected an array of shape (nq, 2) with nq > 0");
+        std::vector<double> w(n * nq);
+        for (std::size_t c = 0; c < n; ++c)
+          cut::moment_fitted_weights(std::span<const double, 4>(p.data() + 4 * c, 4), x,
+                                     std::span<double>(w.data() + nq * c, nq));
+        return to_numpy(std::move(w), {py::ssize_t(n), py::ssize_t(nq)});
+      },
+      py::arg("phi"), py::arg("points"),
+      "Moment-fitted weights of a tensor rule on cut cells: phi (n, 4) vertex values (tensor "
+      "order), points (nq, 2) reference points of a full tensor grid (any order) -> (n, nq) "
+      "weights integrating Q_{m-1} exactly over the inside part (full square: total 1)");
+  m.def(
       "insert_blocks",
       [](dolfinx::la::SparsityPattern& pattern,
          const py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>& dofs) {

@@ -3,11 +3,15 @@
 #include <contact/cut_cell.h>
 #include <gtest/gtest.h>
 #include <numbers>
+#include <random>
+#include <stdexcept>
 
 using namespace contact::cut;
 
 namespace {
-double fraction(std::array<double, 4> phi) { return inside_fraction(phi); }
+double fraction(std::array<double, 4> phi) {
+  return inside_fraction(phi);
+}
 
 /// Integral of f over the inside part with the cut rule of `degree`.
 template <typename F> double integrate(std::array<double, 4> phi, int degree, F f) {
@@ -103,7 +107,7 @@ TEST(CutCell, ElasticityKernelRigidModesSymmetryAndFullCell) {
       EXPECT_NEAR(s, 0.0, 1e-13);
     }
   // uniform strain e_xx = 1 on the inside part: energy = (2 mu + lambda) * area
-  const double unit[12] = {0, 0, 0, 2, 0, 0, 0, 1, 0, 2, 1, 0}; // 2 x 1 rectangle
+  const double unit[12] = {0, 0, 0, 2, 0, 0, 0, 1, 0, 2, 1, 0};          // 2 x 1 rectangle
   double half[Layout::bilinear_size] = {-0.5, 0.5, -0.5, 0.5, 2.0, 3.0}; // X < 1/2
   double B[64] = {};
   elasticity_q1(B, half, nullptr, unit, nullptr, nullptr);
@@ -136,4 +140,141 @@ TEST(CutCell, TractionKernelIntegratesTheClippedFacet) {
   EXPECT_NEAR(b[5], 3 * std::pow(s1, 4) / 4, 1e-14);
   EXPECT_EQ(b[2], 0.0);
   EXPECT_EQ(b[6], 0.0);
+}
+
+namespace {
+/// Tensor Gauss-Legendre points on [0,1]^2 (X slow, Y fast as in basix) and weights, m = 2..4.
+void tensor_gauss(int m, std::vector<double>& pts, std::vector<double>& wts) {
+  std::vector<double> x, w;
+  if (m == 2)
+    x = {0.5 - std::sqrt(3.0) / 6, 0.5 + std::sqrt(3.0) / 6}, w = {0.5, 0.5};
+  else if (m == 3)
+    x = {0.5 - std::sqrt(15.0) / 10, 0.5, 0.5 + std::sqrt(15.0) / 10},
+    w = {5. / 18, 8. / 18, 5. / 18};
+  else {
+    const double a = std::sqrt(3. / 7 - 2. / 7 * std::sqrt(1.2)),
+                 b = std::sqrt(3. / 7 + 2. / 7 * std::sqrt(1.2));
+    const double wa = (18 + std::sqrt(30.0)) / 72, wb = (18 - std::sqrt(30.0)) / 72;
+    x = {0.5 * (1 - b), 0.5 * (1 - a), 0.5 * (1 + a), 0.5 * (1 + b)}, w = {wb, wa, wa, wb};
+  }
+  pts.clear(), wts.clear();
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j)
+      pts.insert(pts.end(), {x[i], x[j]}), wts.push_back(w[i] * w[j]);
+}
+
+std::vector<double> fitted(std::array<double, 4> phi, const std::vector<double>& pts) {
+  std::vector<double> w(pts.size() / 2);
+  moment_fitted_weights(phi, pts, w);
+  return w;
+}
+
+/// Random polynomial in Q_{m-1}: coefficient c[a * m + b] of X^a Y^b.
+struct Poly {
+  int m;
+  std::vector<double> c;
+  double operator()(double X, double Y) const {
+    double s = 0;
+    for (int a = 0; a < m; ++a)
+      for (int b = 0; b < m; ++b)
+        s += c[a * m + b] * std::pow(X, a) * std::pow(Y, b);
+    return s;
+  }
+};
+} // namespace
+
+TEST(MomentFitting, FullCellGivesGaussWeightsEmptyCellZeros) {
+  for (int m : {2, 3, 4}) {
+    std::vector<double> pts, gauss;
+    tensor_gauss(m, pts, gauss);
+    const auto full = fitted({-1, -2, -0.5, -3}, pts);
+    for (std::size_t k = 0; k < gauss.size(); ++k)
+      EXPECT_NEAR(full[k], gauss[k], 2e-16) << "m = " << m << " point " << k;
+    for (double w : fitted({1, 2, 0, 3}, pts)) // phi = 0 is outside
+      EXPECT_EQ(w, 0.0);
+  }
+}
+
+TEST(MomentFitting, ExactForTensorPolynomialsOnStraightCuts) {
+  std::mt19937 gen(7);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (int m : {2, 3, 4}) {
+    std::vector<double> pts, gauss;
+    tensor_gauss(m, pts, gauss);
+    for (int trial = 0; trial < 50; ++trial) {
+      // phi = a + b X + c Y at the vertices: a straight cut through the cell (or none)
+      const double a = 0.5 * U(gen), b = U(gen), c = U(gen);
+      const std::array<double, 4> phi = {a, a + b, a + c, a + b + c};
+      Poly p{m, std::vector<double>(m * m)};
+      for (int i = 0; i < m; ++i)
+        for (int j = 0; j < m; ++j) // m = 4: keep total degree <= 4 (the reference rule's)
+          p.c[i * m + j] = (i + j <= 4) ? U(gen) : 0.0;
+      const auto w = fitted(phi, pts);
+      double s = 0;
+      for (std::size_t k = 0; k < w.size(); ++k)
+        s += w[k] * p(pts[2 * k], pts[2 * k + 1]);
+      EXPECT_NEAR(s, integrate(phi, 4, p), 1e-14) << "m = " << m << " trial " << trial;
+    }
+  }
+  // m = 4, the full Q3 (degree 6) against closed forms: the strip X < s and the corner
+  // triangle X + Y < s, int X^a Y^b = s^(a+1) / ((a+1)(b+1)) and a! b! s^(a+b+2) / (a+b+2)!
+  std::vector<double> pts, gauss;
+  tensor_gauss(4, pts, gauss);
+  const double s = 0.37;
+  const auto strip = fitted({-s, 1 - s, -s, 1 - s}, pts);
+  const auto corner = fitted({-s, 1 - s, 1 - s, 2 - s}, pts);
+  auto fact = [](int n) { return std::tgamma(n + 1.0); };
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b) {
+      double ss = 0, sc = 0;
+      for (std::size_t k = 0; k < strip.size(); ++k) {
+        const double f = std::pow(pts[2 * k], a) * std::pow(pts[2 * k + 1], b);
+        ss += strip[k] * f, sc += corner[k] * f;
+      }
+      EXPECT_NEAR(ss, std::pow(s, a + 1) / ((a + 1) * (b + 1)), 1e-15) << a << " " << b;
+      EXPECT_NEAR(sc, fact(a) * fact(b) * std::pow(s, a + b + 2) / fact(a + b + 2), 1e-16)
+          << a << " " << b;
+    }
+}
+
+TEST(MomentFitting, PointOrderIsFree) {
+  std::vector<double> pts, gauss;
+  tensor_gauss(3, pts, gauss);
+  const std::array<double, 4> phi = {-0.3, 0.5, -0.1, 0.2};
+  const auto w = fitted(phi, pts);
+  std::vector<double> rev(pts.size()); // reversed order, X and Y swapped: still a tensor grid
+  const std::size_t nq = w.size();
+  for (std::size_t k = 0; k < nq; ++k)
+    rev[2 * k] = pts[2 * (nq - 1 - k) + 1], rev[2 * k + 1] = pts[2 * (nq - 1 - k)];
+  const std::array<double, 4> phi_t = {phi[0], phi[2], phi[1], phi[3]}; // transpose the cell
+  const auto wr = fitted(phi_t, rev);
+  for (std::size_t k = 0; k < nq; ++k)
+    EXPECT_NEAR(wr[k], w[nq - 1 - k], 1e-16);
+}
+
+TEST(MomentFitting, NonTensorPointsRejected) {
+  std::vector<double> pts, gauss;
+  tensor_gauss(3, pts, gauss);
+  const std::array<double, 4> phi = {-1, 1, -1, 1};
+  std::vector<double> w(9);
+  auto bad = [&](std::vector<double> p, std::size_t nw) {
+    std::vector<double> out(nw);
+    EXPECT_THROW(moment_fitted_weights(phi, p, out), std::invalid_argument);
+  };
+  EXPECT_NO_THROW(moment_fitted_weights(phi, pts, w));
+  bad({pts.begin(), pts.end() - 2}, 8); // a missing point
+  auto dup = pts;
+  dup[16] = dup[0], dup[17] = dup[1]; // a repeated point instead of the last
+  bad(dup, 9);
+  auto off = pts;
+  off[8] += 1e-3; // one X off its grid line
+  bad(off, 9);
+  bad({pts.begin(), pts.end() - 1}, 8); // odd number of coordinates
+  bad(pts, 8);                          // weights of the wrong size
+  bad({}, 0);
+  std::vector<double> seven; // 7 x 7: beyond max_fitted_points
+  for (int i = 0; i < 7; ++i)
+    for (int j = 0; j < 7; ++j)
+      seven.insert(seven.end(), {(i + 0.5) / 7, (j + 0.5) / 7});
+  bad(seven, 49);
 }

@@ -1,0 +1,86 @@
+"""Boundary conditions and loads of a contact problem (the scene names the boundaries)."""
+
+from dataclasses import dataclass
+
+import numpy as np
+import ufl
+from dolfinx import fem
+
+
+@dataclass
+class Dirichlet:
+    """u[component] = value(lam) on a tagged boundary (component None: all components).
+
+    boundary: a facet-tag name of the scene, or a callable marker x (3, n) -> bool selecting
+    dofs geometrically (e.g. a single point)."""
+
+    boundary: object
+    component: object
+    value: object = 0.0  # float or callable(lam) -> float
+
+    def at(self, lam):
+        return self.value(lam) if callable(self.value) else float(self.value)
+
+
+@dataclass
+class Traction:
+    """Surface traction t(x) (a UFL vector) on a tagged boundary, scaled by scale(lam)."""
+
+    boundary: str
+    traction: object
+    scale: object = None  # callable(lam) -> float; default lam
+
+    def at(self, lam):
+        return lam if self.scale is None else self.scale(lam)
+
+
+@dataclass
+class BodyForce:
+    """Body force f per unit volume on body `body` (a tag; None: every body), scaled by
+    scale(lam) (default lam). f: a UFL vector, or a callable x -> UFL vector with x the
+    spatial coordinate. On cut bodies it is integrated over the inside part only."""
+
+    f: object
+    body: object = None
+    scale: object = None
+
+    def at(self, lam):
+        return lam if self.scale is None else self.scale(lam)
+
+    def form(self, v, measure):
+        x = ufl.SpatialCoordinate(v.ufl_function_space().mesh)
+        f = self.f(x) if callable(self.f) else self.f
+        return ufl.inner(f, v) * measure(self.body)
+
+
+@dataclass
+class Load:
+    """Any UFL right-hand side: form(v, measure) -> a linear form in the test function v
+    (measure(tag) integrates over body `tag`'s material, cut cells included), scaled by
+    scale(lam) (default lam)."""
+
+    form_fn: object
+    scale: object = None
+
+    def at(self, lam):
+        return lam if self.scale is None else self.scale(lam)
+
+    def form(self, v, measure):
+        return self.form_fn(v, measure)
+
+
+def dirichlet_dofs(V, scene, condition):
+    """Local (owned + ghost) unrolled dof indices that `condition` prescribes."""
+    gdim = V.mesh.geometry.dim
+    comps = list(range(gdim)) if condition.component is None else [condition.component]
+    if callable(condition.boundary):
+        dofs = [fem.locate_dofs_geometrical((V.sub(c), V.sub(c).collapse()[0]),
+                                            condition.boundary)[0] for c in comps]
+    else:
+        if condition.boundary not in scene.boundaries:
+            raise ValueError(f"Dirichlet: unknown boundary {condition.boundary!r}; the scene has "
+                             f"{sorted(scene.boundaries)}")
+        facets = scene.facet_tags.find(scene.boundaries[condition.boundary])
+        dofs = [fem.locate_dofs_topological(V.sub(c), V.mesh.topology.dim - 1, facets)
+                for c in comps]
+    return np.concatenate(dofs).astype(np.int32)

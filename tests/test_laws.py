@@ -1,0 +1,99 @@
+"""UFL bulk laws on a user-built scene: isotropic limit of the orthotropic law, linearisation of
+neo-Hookean, and a neo-Hookean block under a rigid flat punch (linear at small load, quadratic
+Newton convergence at large load)."""
+
+import numpy as np
+import pytest
+import ufl
+from dolfinx import fem, mesh as dmesh
+from mpi4py import MPI
+
+from dolfinx_forms import Box
+from dolfinx_forms.laws import LinearElastic, NeoHookean, OrthotropicElastic
+from dolfinx_forms.solver import ContactProblem, Dirichlet, NewtonOptions
+from meshes.scene import Body, Scene, tag_boundaries
+
+E, NU = 1000.0, 0.3
+W, H, A = 2.0, 1.0, 0.25  # block [-W/2, W/2] x [0, H], punch half-width A
+
+
+def block_scene(n=16, cell=dmesh.CellType.triangle):
+    """One body, no contact pair: the block with its bottom, the punch and the top outside it."""
+    m = dmesh.create_rectangle(MPI.COMM_WORLD, [[-W / 2, 0], [W / 2, H]], [2 * n, n], cell)
+    ncells = m.topology.index_map(2).size_local + m.topology.index_map(2).num_ghosts
+    values = np.ones(ncells, np.int32)
+    body = Body("block", 1, Box([-W / 2, 0], [W / 2, H]), np.array([[-W / 2, 0], [W / 2, H]]))
+    tol = 1e-9
+    markers = {"bottom": (1, lambda x: np.isclose(x[1], 0, atol=tol)),
+               "punch": (2, lambda x: np.isclose(x[1], H, atol=tol) & (np.abs(x[0]) <= A + tol))}
+    facet_tags, boundaries = tag_boundaries(m, values, [body], markers)
+    cell_tags = dmesh.meshtags(m, 2, np.arange(ncells, dtype=np.int32), values)
+    return Scene(m, cell_tags, facet_tags, boundaries, [body], [], H / n,
+                 "triangle" if cell == dmesh.CellType.triangle else "quadrilateral")
+
+
+def punch(scene, law, depth, steps=1):
+    bcs = [Dirichlet("bottom", None, 0.0), Dirichlet("punch", 0, 0.0),
+           Dirichlet("punch", 1, lambda lam: -lam * depth)]
+    p = ContactProblem(scene, {1: law}, dirichlet=bcs, newton=NewtonOptions(rtol=1e-11),
+                       log=lambda *a: None)
+    p.solve(steps)
+    return p
+
+
+def matrix(law, scene):
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    u, v, du = fem.Function(V), ufl.TestFunction(V), ufl.TrialFunction(V)
+    dx = ufl.Measure("dx", metadata={"quadrature_degree": 2})
+    A = fem.petsc.assemble_matrix(fem.form(ufl.derivative(law.residual(u, v, dx), u, du)))
+    A.assemble()
+    return A.convert("dense").getDenseArray()
+
+
+def test_orthotropic_isotropic_limit_and_rotation():
+    scene = block_scene(4)
+    G = E / (2 * (1 + NU))
+    iso = OrthotropicElastic(E, E, E, NU, NU, NU, G, angle=0.7)  # rotation-invariant
+    K0, K1 = matrix(LinearElastic(E, NU), scene), matrix(iso, scene)
+    assert np.allclose(K1, K0, rtol=0, atol=1e-10 * np.abs(K0).max())
+    # a genuinely orthotropic law rotated by pi/2 swaps the roles of E1 and E2
+    a = matrix(OrthotropicElastic(3 * E, E, E, 0.2, 0.25, 0.3, 0.4 * E, angle=np.pi / 2), scene)
+    nu21 = 0.2 * E / (3 * E)  # reciprocity nu21 / E2 = nu12 / E1
+    b = matrix(OrthotropicElastic(E, 3 * E, E, nu21, 0.3, 0.25, 0.4 * E), scene)
+    assert np.allclose(a, b, rtol=0, atol=1e-10 * np.abs(b).max())
+    with pytest.raises(ValueError, match="positive definite"):
+        OrthotropicElastic(E, E, E, 0.9, 0.9, 0.9, G)
+
+
+def test_neo_hookean_linearisation_is_linear_elasticity():
+    scene = block_scene(4)
+    K0, K1 = matrix(LinearElastic(E, NU), scene), matrix(NeoHookean(E, NU), scene)
+    assert np.allclose(K1, K0, rtol=0, atol=1e-10 * np.abs(K0).max())
+
+
+def test_neo_hookean_punch_small_load_is_linear():
+    scene = block_scene(8)
+    d = 1e-6 * H
+    lin = punch(scene, LinearElastic(E, NU), d).reaction("punch")
+    nh = punch(scene, NeoHookean(E, NU), d).reaction("punch")
+    assert lin[1] < 0  # the punch pushes the block down
+    # finite-strain correction is O(strain) = O(1e-6) relative
+    assert abs(nh[1] - lin[1]) <= 1e-4 * abs(lin[1])
+
+
+def test_neo_hookean_punch_large_load_quadratic_newton():
+    scene = block_scene(8)
+    p = punch(scene, NeoHookean(E, NU), 0.15 * H)  # 15 % indentation in one step
+    r = np.array(p.steps[-1].residuals)
+    assert p.steps[-1].iterations <= 10
+    # quadratic convergence: once in the basin, r_{k+1} <= C r_k^2 with C bounded, i.e. the
+    # number of correct digits roughly doubles (checked on the last three iterations above
+    # the round-off floor)
+    rr = r / r[0]
+    tail = [k for k in range(1, len(rr)) if rr[k - 1] < 1e-2 and rr[k] > 1e-14]
+    assert tail, f"no iterate in the quadratic basin: {rr}"
+    for k in tail:
+        assert np.log10(rr[k]) <= 1.6 * np.log10(rr[k - 1]), rr
+    # at 15 % indentation the finite-strain response differs measurably from the linear one
+    lin = punch(scene, LinearElastic(E, NU), 0.15 * H).reaction("punch")[1]
+    assert abs(p.reaction("punch")[1] - lin) > 1e-3 * abs(lin)
