@@ -46,3 +46,20 @@ from ._cpp import (  # noqa: F401  (re-exported API)
 )
 
 __version__ = "0.1.0"
+
+
+def _setup():
+    """Quiet JIT loggers (logs.py) and, under mpirun, an error on one rank ends every rank
+    (parallel.py)."""
+    from . import logs
+
+    logs.configure()
+    from mpi4py import MPI
+
+    if MPI.COMM_WORLD.size > 1:
+        from . import parallel
+
+        parallel.install()
+
+
+_setup()

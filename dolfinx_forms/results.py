@@ -1,16 +1,16 @@
 """The results contract: metrics.json keys and atomic output folders.
 
 One source of truth for the layout of metrics.json; every demo builds its record
-with `new_metrics` and writes with `write_results`.
+with `new_metrics` and writes with `write_results`. Result folders (the --out rules, the
+marker file, atomic replacement): folders.py.
 """
 
 import json
-import os
-import shutil
-import tempfile
 import time
 from contextlib import contextmanager
 from pathlib import Path
+
+from .folders import MARKER, OutputFolderError, atomic_output_dir  # noqa: F401
 
 PHASES = ("total", "mesh", "assembly", "contact", "solve")
 
@@ -63,40 +63,6 @@ def _check_finite(obj, path="metrics"):
     if isinstance(obj, (list, tuple)):
         for i, v in enumerate(obj):
             _check_finite(v, f"{path}[{i}]")
-
-
-@contextmanager
-def atomic_output_dir(out, comm=None):
-    """Yield a temporary folder beside `out`, shared by all ranks of `comm` (default
-    COMM_WORLD); it replaces `out` in one rename when every rank succeeded and is removed on
-    any failure, leaving `out` untouched (no half-written results)."""
-    from mpi4py import MPI
-
-    comm = MPI.COMM_WORLD if comm is None else comm
-    out = Path(out).resolve()
-    tmp = None
-    if comm.rank == 0:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent)
-    tmp = Path(comm.bcast(tmp, root=0))
-    ok = False
-    try:
-        yield tmp
-        ok = True
-    finally:
-        ok = comm.allreduce(ok, op=MPI.LAND)
-        if comm.rank == 0:
-            if ok:
-                if out.exists():
-                    old = out.with_name(f".{out.name}.old.{os.getpid()}")
-                    os.replace(out, old)
-                    os.replace(tmp, out)
-                    shutil.rmtree(old, ignore_errors=True)
-                else:
-                    os.replace(tmp, out)
-            else:
-                shutil.rmtree(tmp, ignore_errors=True)
-        comm.barrier()
 
 
 def write_metrics(folder, metrics):

@@ -1,9 +1,11 @@
-"""Cut-cell forms (dolfinx_forms/cut.py): the C++ cut kernels inside one dolfinx Form.
+"""Cut-cell integration (dolfinx_forms/cut.py): any UFL form on the inside part of cut cells.
 
-Checks against independent formulations: the FFCx kernel of the same UFL form on uncut cells
-(to round-off), rigid-body modes (zero energy with and without ghost penalty), the ghost
-penalty's zero action on linear fields, the cut traction load against its closed form, and the
-cut rule's disc area at second order (the vectorised binding used by diagnostics).
+Checks against independent formulations: FFCx's own rule on uncut cells (to round-off), the
+elastic energy of random Q1 fields against the sub-triangle rule of `cut_square_rule` (both
+exact for Q2 integrands), rigid-body modes (zero energy with and without ghost penalty), the
+ghost penalty's zero action on linear fields, body forces against the inside area and first
+moment, the cut traction load against its closed form, and the cut rule's disc area at second
+order (the vectorised binding used by diagnostics).
 """
 
 from types import SimpleNamespace
@@ -16,8 +18,8 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from dolfinx_forms import _cpp
-from dolfinx_forms.cut import CUT, GHOST, INTERIOR, CutForms
-from dolfinx_forms.solver import plane_strain
+from dolfinx_forms.cut import CUT, GHOST, INTERIOR, CutIntegration
+from dolfinx_forms.laws import LinearElastic
 
 E, NU = 3.0, 0.3
 
@@ -52,18 +54,98 @@ def _matrix(form):
     return A
 
 
-def test_cut_kernel_equals_ffcx_on_uncut_cells():
-    scene, phi, kind = _scene()
-    scene.cut.kind_tags.values[:] = CUT  # every cell through the C++ kernel, phi < 0 everywhere
+LAW = LinearElastic(E, NU)
+
+
+def _forms(scene, phi, gamma=0.0):
+    """(integration, bilinear form) of LAW on the scene's material, ghost penalty gamma."""
+    cut = CutIntegration(scene, phi=phi)
     V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
-    A = _matrix(CutForms(V, scene, {1: (E, NU)}, ghost_penalty=0.0, phi=phi).a)
-    mu, lmb = plane_strain(E, NU)
+    u, du, v = fem.Function(V), ufl.TrialFunction(V), ufl.TestFunction(V)
+    a = ufl.derivative(LAW.residual(u, v, cut.measure()), u, du)
+    if gamma > 0:
+        pm = fem.Function(fem.FunctionSpace(scene.mesh, ("DG", 0)))
+        pm.x.array[:] = LAW.p_modulus
+        a += cut.ghost_penalty(du, v, gamma, pm)
+    return cut, V, fem.form(a)
+
+
+def test_cut_weights_equal_ffcx_on_uncut_cells():
+    scene, phi, kind = _scene()
+    scene.cut.kind_tags.values[:] = CUT  # every cell through the weights, phi < 0 everywhere
+    cut, V, a = _forms(scene, phi)
+    assert np.allclose(cut.factor.x.array, 1.0, rtol=0, atol=1e-13)
+    A = _matrix(a)
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-    eps = lambda w: ufl.sym(ufl.grad(w))  # noqa: E731
-    B = _matrix(fem.form(ufl.inner(2 * mu * eps(u) + lmb * ufl.tr(eps(u)) * ufl.Identity(2),
-                                   eps(v)) * ufl.dx))
+    B = _matrix(fem.form(ufl.inner(LAW.stress(u), ufl.grad(v)) * ufl.dx))
     A.axpy(-1.0, B)
     assert A.norm() <= 1e-12 * B.norm()
+
+
+def test_cut_energy_equals_sub_triangle_rule():
+    # energy of random Q1 fields on a mesh cut by a line and a circle: the moment-fitted
+    # weights (FFCx, 3x3 points) and the degree-4 sub-triangle rule are both exact for Q2
+    levelset = lambda x: np.minimum(x[1] - 0.31 * x[0] - 0.43,  # noqa: E731
+                                    np.hypot(x[0] - 1.3, x[1] - 0.2) - 0.3)
+    scene, phi, kind = _scene(8, 5, levelset)
+    cut, V, a = _forms(scene, phi)
+    A = _matrix(a)
+    m = scene.mesh
+    nc = len(kind)
+    pdofs = phi.function_space.dofmap.list.array.reshape(nc, 4)
+    vdofs = V.dofmap.list.array.reshape(nc, 4)
+    xg = m.geometry.x[m.geometry.dofmap.array.reshape(nc, 4)][:, :, :2]
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        w = fem.Function(V)
+        w.x.array[:] = rng.standard_normal(len(w.x.array))
+        y = A.createVecLeft()
+        A.mult(w.vector, y)
+        energy = w.vector.dot(y)
+        ref = 0.0
+        for c in range(nc):  # reference: sub-triangle rule, Q1 gradients on the rectangle
+            if kind[c] == INTERIOR:
+                q = _cpp.cut_quadrature(-np.ones((1, 4)), 4)
+            else:
+                q = _cpp.cut_quadrature(phi.x.array[pdofs[c]][None, :], 4)
+            if not len(q["weights"]):
+                continue
+            X, Y = q["points"][:, 0], q["points"][:, 1]
+            J = np.column_stack([xg[c, 1] - xg[c, 0], xg[c, 2] - xg[c, 0]])  # affine cell
+            # tensor-order Q1 basis derivatives on the reference square, then to x, y
+            dref = np.stack([np.stack([-(1 - Y), 1 - Y, -Y, Y], 1),
+                             np.stack([-(1 - X), -X, 1 - X, X], 1)], 2)  # (np, 4, 2)
+            dphys = dref @ np.linalg.inv(J)  # rows: grad_X N J^-1 = grad_x N
+            uc = w.x.array.reshape(-1, 2)[vdofs[c]]  # (4, 2)
+            G = np.einsum("pnd,nc->pcd", dphys, uc)  # (np, 2 components, 2 derivatives)
+            eps = 0.5 * (G + G.transpose(0, 2, 1))
+            tr = eps[:, 0, 0] + eps[:, 1, 1]
+            dens = 2 * LAW.mu * np.sum(eps * eps, axis=(1, 2)) + LAW.lmbda * tr**2
+            ref += abs(np.linalg.det(J)) * np.dot(q["weights"], dens)
+        assert energy == pytest.approx(ref, rel=1e-12)
+
+
+def test_body_force_is_the_inside_integral():
+    # f = (1, x): total x-force = inside area, total y-force = int x over the inside
+    scene, phi, kind = _scene(8, 5, lambda x: np.hypot(x[0] - 1.1, x[1] - 0.45) - 0.37)
+    cut, V, _ = _forms(scene, phi)
+    v = ufl.TestFunction(V)
+    X = ufl.SpatialCoordinate(scene.mesh)
+    b = fem.petsc.assemble_vector(fem.form(ufl.inner(ufl.as_vector((1.0, X[0])), v)
+                                           * cut.measure()))
+    pdofs = phi.function_space.dofmap.list.array.reshape(len(kind), 4)
+    h2 = (2 / 8) * (1 / 5)
+    area = h2 * _cpp.inside_fraction(phi.x.array[pdofs]).sum()
+    f = b.array.reshape(-1, 2)
+    assert f[:, 0].sum() == pytest.approx(area, rel=1e-13)
+    q = _cpp.cut_quadrature(phi.x.array[pdofs], 4)  # int x over the inside, sub-triangles
+    xg = scene.mesh.geometry.x[scene.mesh.geometry.dofmap.array.reshape(len(kind), 4)]
+    cells = np.repeat(np.arange(len(kind)), np.diff(q["offsets"]))
+    P = q["points"]
+    x = (xg[cells, 0, 0] + P[:, 0] * (xg[cells, 1, 0] - xg[cells, 0, 0])
+         + P[:, 1] * (xg[cells, 2, 0] - xg[cells, 0, 0]))  # affine map of the tensor cell
+    moment = h2 * np.dot(q["weights"], x)
+    assert f[:, 1].sum() == pytest.approx(moment, rel=1e-12)
 
 
 @pytest.mark.parametrize("gamma", [0.0, 0.1])
@@ -72,9 +154,8 @@ def test_rigid_modes_zero_energy_and_ghost_penalty_linear_fields(gamma):
     scene, phi, kind = _scene(8, 5, lambda x: np.minimum(x[1] - 0.31 * x[0] - 0.43,
                                                            np.hypot(x[0] - 1.3, x[1] - 0.2) - 0.3))
     assert np.sum(kind == CUT) > 5
-    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
-    forms = CutForms(V, scene, {1: (E, NU)}, ghost_penalty=gamma, phi=phi)
-    A = _matrix(forms.a)
+    _, V, a = _forms(scene, phi, gamma)
+    A = _matrix(a)
     modes = [lambda x: np.stack([1 + 0 * x[0], 0 * x[0]]), lambda x: np.stack([0 * x[0], 1 + 0 * x[0]]),
              lambda x: np.stack([-x[1], x[0]])]
     r = fem.Function(V)
@@ -85,7 +166,7 @@ def test_rigid_modes_zero_energy_and_ghost_penalty_linear_fields(gamma):
         assert y.norm() <= 1e-12 * A.norm() * r.vector.norm()
     # a linear non-rigid field: the ghost penalty adds nothing (its gradient has no jumps)
     r.interpolate(lambda x: np.stack([0.3 * x[0] + 0.2 * x[1], -0.1 * x[0] + 0.5 * x[1]]))
-    A0 = _matrix(CutForms(V, scene, {1: (E, NU)}, ghost_penalty=0.0, phi=phi).a)
+    A0 = _matrix(_forms(scene, phi, 0.0)[2])
     y0 = A0.createVecLeft()
     A.mult(r.vector, y)
     A0.mult(r.vector, y0)
@@ -107,10 +188,9 @@ def test_cut_traction_is_the_clipped_facet_integral():
     facets = dmesh.locate_entities_boundary(m, 1, lambda x: np.isclose(x[0], 0.0))
     scene.facet_tags = dmesh.meshtags(m, 1, np.sort(facets).astype(np.int32),
                                       np.full(len(facets), 7, np.int32))
-    V = fem.VectorFunctionSpace(m, ("Lagrange", 1))
-    forms = CutForms(V, scene, {1: (E, NU)}, ghost_penalty=0.0, phi=phi)
+    cut, V, _ = _forms(scene, phi)
     X = ufl.SpatialCoordinate(m)
-    b = fem.petsc.assemble_vector(forms.traction_form(ufl.as_vector((X[1], X[0] * X[1] + 2)), 7))
+    b = fem.petsc.assemble_vector(cut.traction_form(V, ufl.as_vector((X[1], X[0] * X[1] + 2)), 7))
     f = b.array.reshape(-1, 2).sum(axis=0)
     assert f[0] == pytest.approx(0.53 ** 2 / 2, rel=1e-13)
     assert f[1] == pytest.approx(2 * 0.53, rel=1e-13)

@@ -70,10 +70,10 @@ void bind_cut(py::module_& m) {
       "cut_moment_weights",
       [](const carray& phi, const carray& points) {
         const auto p = as_span(phi, "phi", 4);
-        const auto x = as_span(points, "points", 2);
+        if (points.ndim() != 2 or points.shape(1) != 2 or points.shape(0) == 0)
+          throw std::invalid_argument("points: expected an array of shape (nq, 2), nq > 0");
+        const std::span<const double> x(points.data(), std::size_t(points.size()));
         const std::size_t n = p.size() / 4, nq = x.size() / 2;
-        if (nq == 0)
-          throw std::invalid_argument("points: expected an array of shape (nq, 2) with nq > 0");
         std::vector<double> w(n * nq);
         for (std::size_t c = 0; c < n; ++c)
           cut::moment_fitted_weights(std::span<const double, 4>(p.data() + 4 * c, 4), x,
