@@ -15,6 +15,8 @@ APT_PACKAGES := cmake make gcc g++ python3-sympy python3-dolfinx libdolfinx-dev 
 export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1
+# demos, tests and benchmarks import dolfinx_forms and meshes from this tree (no sys.path edits)
+export PYTHONPATH := $(CURDIR)$(if $(PYTHONPATH),:$(PYTHONPATH))
 MPIRUN  ?= mpirun -n 2
 SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 

@@ -45,20 +45,21 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+from mpi4py import MPI
+
+from dolfinx_forms import analytic
+from dolfinx_forms.cli import DemoParser, bounded
+from dolfinx_forms.solver import ContactProblem, ContactSolverError
+from meshes.cut import patch_cut_scene
+from meshes.patch import patch_dirichlet
+
+if __package__:  # imported as benchmarks.small_cuts (tests)
+    from .work_precision import git_head, write_atomic
+else:  # run as a script: benchmarks/ is sys.path[0]
+    from work_precision import git_head, write_atomic
+
 ROOT = Path(__file__).resolve().parents[1]
-for _p in (ROOT, ROOT / "benchmarks"):
-    if str(_p) not in sys.path:
-        sys.path.insert(0, str(_p))
-
-import numpy as np  # noqa: E402
-from mpi4py import MPI  # noqa: E402
-
-from dolfinx_forms import analytic  # noqa: E402
-from dolfinx_forms.cli import DemoParser, bounded  # noqa: E402
-from dolfinx_forms.solver import ContactProblem, ContactSolverError  # noqa: E402
-from meshes.cut import patch_cut_scene  # noqa: E402
-from meshes.patch import patch_dirichlet  # noqa: E402
-from work_precision import git_head, write_atomic  # noqa: E402
 
 E, NU, D, EPS0 = 1.0, 0.3, 0.01, 1e-3
 HEIGHT = WIDTH = 1.0

@@ -40,10 +40,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from dolfinx_forms.cli import DemoParser
 
-from dolfinx_forms.cli import DemoParser  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def _load_study():

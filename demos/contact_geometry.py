@@ -19,16 +19,15 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import dolfinx_forms as df  # noqa: E402
-from dolfinx_forms.cli import DemoParser, bounded  # noqa: E402
-from dolfinx_forms.results import (PhaseTimer, atomic_output_dir, new_metrics,  # noqa: E402
+import dolfinx_forms as df
+from dolfinx_forms.cli import DemoParser, bounded
+from dolfinx_forms.results import (PhaseTimer, atomic_output_dir, new_metrics,
                                    write_metrics)
 
 
 def parse(argv=None):
     p = DemoParser(description=__doc__.split("\n")[0])
-    p.add_argument("--out", default="results/contact_geometry", help="output folder")
+    p.add_out("results/contact_geometry")
     p.add_argument("--R", type=bounded("R", 0, lo_open=True), default=10.0, help="radius (mm)")
     p.add_argument("--gap", type=bounded("gap", 0), default=0.02, help="initial gap (mm)")
     p.add_argument("--h", type=bounded("h", 0, lo_open=True), default=0.05,
@@ -88,7 +87,7 @@ def main(argv=None):
         projection_max_iterations=int(max(pi["iterations"].max(), pj["iterations"].max())))
     m["analytic"].update(min_gap=g)
 
-    with atomic_output_dir(args.out) as tmp:
+    with atomic_output_dir(args.out, force=args.force) as tmp:
         write_metrics(tmp, m)
         with open(tmp / "contact_points.csv", "w", newline="") as f:
             w = csv.writer(f)

@@ -38,7 +38,6 @@ The helpers run_hertz, loglog_rate and VARIANTS are shared with benchmarks/work_
 
 import json
 import math
-import os
 import shutil
 import signal
 import subprocess
@@ -47,14 +46,12 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
+
+from dolfinx_forms import analytic
+from dolfinx_forms.cli import DemoParser, bounded
+
 ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
-import numpy as np  # noqa: E402
-
-from dolfinx_forms import analytic  # noqa: E402
-from dolfinx_forms.cli import DemoParser, bounded  # noqa: E402
 
 HERTZ = ROOT / "demos" / "hertz.py"
 # The Hertz case (the defaults of demos/hertz.py), passed explicitly to every run so that the
@@ -170,8 +167,7 @@ def parse(argv):
     p.add_argument("--sizes", default=",".join(map(str, SIZES)),
                    help="comma-separated k of the mesh sizes h = a/k, at least 2 distinct, "
                         "each in [2, 400] (default 10,20,40,80)")
-    p.add_argument("--out", default="results/convergence",
-                   help="result folder (replaced atomically)")
+    p.add_out("results/convergence")
     p.add_argument("--timeout", type=bounded("--timeout", 0, None, lo_open=True), default=3600.0,
                    help="seconds before one run is killed and recorded as failed")
     a = p.parse_args(argv)
@@ -186,16 +182,6 @@ def parse(argv):
     if len(a.sizes) < 2:
         p.error("--sizes: a rate needs at least 2 sizes")
     a.sizes = sorted(a.sizes)  # coarse to fine
-    out = Path(a.out).resolve()
-    if out.exists() and not out.is_dir():
-        p.error(f"--out: {a.out} exists and is not a folder")
-    anc = out.parent
-    while not anc.exists():
-        anc = anc.parent
-    try:  # probe (and remove at once) a folder where the outputs will be created, before runs
-        os.rmdir(tempfile.mkdtemp(prefix=".convergence_probe.", dir=anc))
-    except OSError as e:
-        p.error(f"--out: cannot create {a.out} ({anc}: {e.strerror})")
     a.discretizations = ["conforming", "cut"] if a.discretization == "both" else [a.discretization]
     return a
 
@@ -329,10 +315,10 @@ def main(argv=None):
             summary={d: summarize([r for r in runs if r["discretization"] == d])
                      for d in args.discretizations},
         )
-        from dolfinx_forms.results import atomic_output_dir
+        from dolfinx_forms.results import OutputFolderError, atomic_output_dir
 
         try:
-            with atomic_output_dir(args.out) as tmp:
+            with atomic_output_dir(args.out, force=args.force) as tmp:
                 for r in runs:
                     if r["ok"]:
                         shutil.copytree(Path(scratch) / r["name"], tmp / "runs" / r["name"])
@@ -340,6 +326,9 @@ def main(argv=None):
                 with open(tmp / "convergence.json", "w") as f:
                     json.dump(data, f, indent=2, allow_nan=False)
                     f.write("\n")
+        except OutputFolderError as e:  # the folder changed during the runs (checked before)
+            sys.stderr.write(f"convergence_study.py: error: {e}\n")
+            return 1
         except OSError as e:
             sys.stderr.write(f"convergence_study.py: error: --out: cannot write {args.out}: {e}\n")
             return 1

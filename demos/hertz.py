@@ -24,27 +24,25 @@ mapping with its consistent tangent (Algorithm 1, eq 48), Newton with load steps
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import numpy as np
+from mpi4py import MPI
 
-import numpy as np  # noqa: E402
-from mpi4py import MPI  # noqa: E402
-
-from dolfinx_forms import analytic  # noqa: E402
-from dolfinx_forms.cli import (DemoParser, add_discretization, bounded,  # noqa: E402
+from dolfinx_forms import analytic
+from dolfinx_forms.cli import (DemoParser, add_discretization, bounded,
                                check_discretization, petsc_options)
-from dolfinx_forms.output import atomic_output, finish, gather_points, plot_tractions  # noqa: E402
-from dolfinx_forms.results import PhaseTimer, new_metrics  # noqa: E402
-from dolfinx_forms.solver import (ContactProblem, ContactSolverError, Dirichlet,  # noqa: E402
+from dolfinx_forms.output import atomic_output, finish, gather_points, plot_tractions
+from dolfinx_forms.results import PhaseTimer, new_metrics
+from dolfinx_forms.solver import (ContactProblem, ContactSolverError, Dirichlet,
                                   NewtonOptions, solver_metrics, zone_ends)
-from meshes.cut import hertz_cut_scene  # noqa: E402
-from meshes.hertz import hertz_scene  # noqa: E402
+from meshes.cut import hertz_cut_scene
+from meshes.hertz import hertz_scene
 
 DEFAULTS = dict(R=10.0, E=1.0e4, nu=0.3, load=430.0)
 
 
 def parse(argv):
     p = DemoParser(prog="hertz.py", description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", default="results/hertz", help="result folder (replaced atomically)")
+    p.add_out("results/hertz")
     add_discretization(p)
     p.add_argument("--h", type=bounded("--h", 0, None, lo_open=True), default=None,
                    help="mesh size at the contact (default a/20 of the Hertz estimate)")
@@ -134,7 +132,7 @@ def main(argv=None):
     if comm.rank == 0:
         evaluate(metrics, pts, reaction, args, E_star, Q)
     timer.stop()
-    with atomic_output(args.out, comm) as folder:
+    with atomic_output(args.out, comm, force=args.force) as folder:
         finish(folder, metrics, problem, pts,
                plot=(lambda path: plot(path, pts, metrics, args)) if comm.rank == 0 else None)
     if comm.rank == 0:

@@ -66,19 +66,17 @@ mapping with its consistent tangent (Algorithm 1, eq 48), Newton with load steps
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import numpy as np
+from mpi4py import MPI
 
-import numpy as np  # noqa: E402
-from mpi4py import MPI  # noqa: E402
-
-from dolfinx_forms.cli import (DemoParser, add_discretization, bounded,  # noqa: E402
+from dolfinx_forms.cli import (DemoParser, add_discretization, bounded,
                                check_discretization, petsc_options)
-from dolfinx_forms.output import atomic_output, finish, gather_points, plot_tractions  # noqa: E402
-from dolfinx_forms.results import PhaseTimer, new_metrics  # noqa: E402
-from dolfinx_forms.solver import (ContactProblem, ContactSolverError, Dirichlet,  # noqa: E402
+from dolfinx_forms.output import atomic_output, finish, gather_points, plot_tractions
+from dolfinx_forms.results import PhaseTimer, new_metrics
+from dolfinx_forms.solver import (ContactProblem, ContactSolverError, Dirichlet,
                                   solver_metrics)
-from meshes.cut import cut_counts, incline_cut_scene  # noqa: E402
-from meshes.incline import incline_scene  # noqa: E402
+from meshes.cut import cut_counts, incline_cut_scene
+from meshes.incline import incline_scene
 
 SIZE, SLOPE, INTERCEPT = 1000.0, 0.2, 458.6  # mm; interface y = SLOPE x + INTERCEPT
 X0 = SIZE / 2  # u_x = 0 at x = X0 on top and bottom (uniaxial supports)
@@ -87,8 +85,7 @@ SLIP_TOL = 1e-6  # plastic slip threshold, relative to the imposed displacement
 
 def parse(argv):
     p = DemoParser(prog="inclined_interface.py", description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", default="results/inclined_interface",
-                   help="result folder (replaced atomically)")
+    p.add_out("results/inclined_interface")
     add_discretization(p)
     p.add_argument("--h", type=bounded("--h", 0, 250, lo_open=True), default=25.0,
                    help="mesh size (mm; cut: grid spacing 1000 / round(1000 / h))")
@@ -203,7 +200,7 @@ def main(argv=None):
     if comm.rank == 0:
         evaluate(metrics, pts, g_t, reaction, ref, args)
     timer.stop()
-    with atomic_output(args.out, comm) as folder:
+    with atomic_output(args.out, comm, force=args.force) as folder:
         finish(folder, metrics, problem, pts,
                plot=(lambda path: plot(Path(path).parent, pts, g_t, metrics, ref, args))
                if comm.rank == 0 else None)
@@ -243,7 +240,7 @@ def tangential_jump(problem):
     """(x, g_t): the total tangential jump at this rank's contact points, last accepted step."""
     cat = lambda a: np.concatenate(a) if a else np.zeros(0)  # noqa: E731
     return (cat([g.points[:, 0] for g in problem.pairs]),
-            cat([s["g_t"] for s in problem.committed]))
+            cat([s["g_t"] for s in problem.contact.committed]))
 
 
 def evaluate(metrics, pts, g_t, reaction, ref, args):

@@ -20,24 +20,22 @@ round-off for any cut height.
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import numpy as np
+from mpi4py import MPI
 
-import numpy as np  # noqa: E402
-from mpi4py import MPI  # noqa: E402
-
-from dolfinx_forms import analytic  # noqa: E402
-from dolfinx_forms.cli import (DemoParser, add_discretization, bounded,  # noqa: E402
+from dolfinx_forms import analytic
+from dolfinx_forms.cli import (DemoParser, add_discretization, bounded,
                                check_discretization, petsc_options)
-from dolfinx_forms.output import atomic_output, finish, gather_points, plot_tractions  # noqa: E402
-from dolfinx_forms.results import PhaseTimer, new_metrics  # noqa: E402
-from dolfinx_forms.solver import ContactProblem, ContactSolverError, solver_metrics  # noqa: E402
-from meshes.cut import patch_cut_scene  # noqa: E402
-from meshes.patch import patch_dirichlet, patch_scene  # noqa: E402
+from dolfinx_forms.output import atomic_output, finish, gather_points, plot_tractions
+from dolfinx_forms.results import PhaseTimer, new_metrics
+from dolfinx_forms.solver import ContactProblem, ContactSolverError, solver_metrics
+from meshes.cut import patch_cut_scene
+from meshes.patch import patch_dirichlet, patch_scene
 
 
 def parse(argv):
     p = DemoParser(prog="patch_test.py", description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", default="results/patch_test")
+    p.add_out("results/patch_test")
     add_discretization(p)
     p.add_argument("--interface", type=bounded("--interface", 0, 1, lo_open=True, hi_open=True),
                    default=None, help="cut path: height of the interface, off the grid lines "
@@ -126,7 +124,7 @@ def main(argv=None):
         plot_tractions(path, pts, {"exact": (xs, [exact] * 2), "penalised": (xs, [penalised] * 2)},
                        title="patch test", xlabel="x", ylabel="traction")
 
-    with atomic_output(args.out, comm) as folder:
+    with atomic_output(args.out, comm, force=args.force) as folder:
         finish(folder, metrics, problem, pts, plot=plot if comm.rank == 0 else None)
     if comm.rank == 0:
         r = metrics["results"]

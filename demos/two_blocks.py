@@ -65,20 +65,18 @@ mapping with its consistent tangent (Algorithm 1, eq 48), Newton with load steps
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import numpy as np
+import ufl
+from mpi4py import MPI
 
-import numpy as np  # noqa: E402
-import ufl  # noqa: E402
-from mpi4py import MPI  # noqa: E402
-
-from dolfinx_forms.cli import (DemoParser, add_discretization, bounded,  # noqa: E402
+from dolfinx_forms.cli import (DemoParser, add_discretization, bounded,
                                check_discretization, petsc_options)
-from dolfinx_forms.output import atomic_output, finish, gather_points, plot_tractions  # noqa: E402
-from dolfinx_forms.results import PhaseTimer, new_metrics  # noqa: E402
-from dolfinx_forms.solver import (ContactProblem, ContactSolverError, Dirichlet,  # noqa: E402
+from dolfinx_forms.output import atomic_output, finish, gather_points, plot_tractions
+from dolfinx_forms.results import PhaseTimer, new_metrics
+from dolfinx_forms.solver import (ContactProblem, ContactSolverError, Dirichlet,
                                   Traction, solver_metrics, zone_ends)
-from meshes.cut import cut_counts, two_blocks_cut_scene  # noqa: E402
-from meshes.two_blocks import two_blocks_scene  # noqa: E402
+from meshes.cut import cut_counts, two_blocks_cut_scene
+from meshes.two_blocks import two_blocks_scene
 
 DEFAULTS = dict(h=0.2, E=1.0e5, nu=0.3, mu=1.0, displacement=1.6e-3, eps0=1.0, steps=1)
 WIDTH, HEIGHT, WIDTH_UPPER = 40.0, 10.0, 20.0  # mm (Tur et al. 2009)
@@ -88,8 +86,7 @@ LINE_Y = 5.0  # sigma_x is sampled along y = LINE_Y (mid-height of the lower blo
 
 def parse(argv):
     p = DemoParser(prog="two_blocks.py", description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", default="results/two_blocks",
-                   help="result folder (replaced atomically)")
+    p.add_out("results/two_blocks")
     add_discretization(p)
     p.add_argument("--h", type=bounded("--h", 0, 2.5, lo_open=True), default=DEFAULTS["h"],
                    help="mesh size of both blocks (mm; cut: grid spacing)")
@@ -173,7 +170,7 @@ def main(argv=None):
             "y": LINE_Y, "file": "sigma_x_line.csv",
             "min": float(np.min(line[:, 1])), "max": float(np.max(line[:, 1]))}
     timer.stop()
-    with atomic_output(args.out, comm) as folder:
+    with atomic_output(args.out, comm, force=args.force) as folder:
         if comm.rank == 0:
             np.savetxt(Path(folder) / "sigma_x_line.csv", line, delimiter=",", fmt="%.12e",
                        header="x,sigma_x", comments="")

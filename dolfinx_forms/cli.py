@@ -1,16 +1,73 @@
 """Command-line contract shared by all demos (see docs/benchmarks.md in shared docs).
 
 A bad value stops the run with ONE line naming the parameter and the accepted range,
-exit status 2, before anything is written.
+exit status 2, before anything is written (on every MPI rank: every rank parses).
+`--help` shows each option's default. Every program has `--verbose` (the JIT compiler's log
+lines, also ILS_VERBOSE=1); programs that write a result folder declare it with
+:meth:`DemoParser.add_out`, which adds `--out` and `--force` and checks the folder while
+parsing (rules: folders.py), so a run never computes and then refuses its output folder.
 """
 
 import argparse
+import copy
 import math
 import sys
 
+from .folders import OutputFolderError, check_output_path
+from .logs import set_verbose
+
+FORCE_HELP = ("write into an existing folder that is not a result folder of this code, adding "
+              "the results next to its content (nothing there is deleted or overwritten)")
+
+
+class DefaultsFormatter(argparse.HelpFormatter):
+    """Help text with each option's default (options that take a value and have one)."""
+
+    @staticmethod
+    def _shows_default(action):
+        return (bool(action.option_strings) and action.nargs != 0
+                and action.default not in (None, [], argparse.SUPPRESS, ""))
+
+    def _format_action(self, action):
+        if not action.help and self._shows_default(action):
+            action = copy.copy(action)
+            action.help = "default: %(default)s"
+        return super()._format_action(action)
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if self._shows_default(action) and "%(default)" not in text:
+            text += " (default: %(default)s)"
+        return text
+
 
 class DemoParser(argparse.ArgumentParser):
-    """argparse with one-line errors (argparse prints usage + error by default)."""
+    """argparse with one-line errors (argparse prints usage + error by default), defaults in
+    --help, --verbose, and the result-folder options of :meth:`add_out`."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", DefaultsFormatter)
+        super().__init__(*args, **kwargs)
+        self._out_dest = None
+        self.add_argument("--verbose", action="store_true",
+                          help="show the JIT compiler's log lines (also: ILS_VERBOSE=1)")
+
+    def add_out(self, default, help="result folder (replaced atomically)"):
+        """--out DIR (checked while parsing, see folders.py) and --force."""
+        self.add_argument("--out", default=default, help=help)
+        self.add_argument("--force", action="store_true", help=FORCE_HELP)
+        self._out_dest = "out"
+
+    def parse_args(self, args=None, namespace=None):
+        a = super().parse_args(args, namespace)
+        if getattr(a, "verbose", False):
+            set_verbose(True)
+        if self._out_dest is not None:
+            try:
+                check_output_path(getattr(a, self._out_dest), force=a.force)
+            except OutputFolderError as e:
+                self.error(str(e))
+        return a
 
     def error(self, message):
         sys.stderr.write(f"{self.prog}: error: {message}\n")

@@ -196,38 +196,55 @@ def _write_marker(folder: Path, program: str, files, **extra):
     os.replace(tmp, folder / MARKER)
 
 
+def _clashes(src: Path, dst: Path, rel: str, ours: set) -> list:
+    """Entries of `src` that would replace something in `dst` this code did not write."""
+    out = []
+    for e in sorted(src.iterdir()):
+        r, t = f"{rel}{e.name}", dst / e.name
+        if r == MARKER or not os.path.lexists(t):
+            continue
+        if e.is_dir() and t.is_dir() and not t.is_symlink():
+            out += _clashes(e, t, r + "/", ours)  # merge into the existing folder
+        elif r not in ours or (t.is_dir() and not t.is_symlink()):
+            out.append(r)
+    return out
+
+
+def _move_in(src: Path, dst: Path):
+    """Move the entries of `src` into `dst` (checked by _clashes): files atomically replaced,
+    new folders renamed in, existing folders merged."""
+    for e in sorted(src.iterdir()):
+        t = dst / e.name
+        if e.is_dir() and t.is_dir() and not t.is_symlink():
+            _move_in(e, t)
+        else:
+            os.replace(e, t)
+
+
 def _merge(tmp: Path, out: Path, program: str):
-    """--force into a folder with foreign content: move our top-level entries in one by one
-    (each atomically), replacing only entries an earlier marker lists; then the marker."""
+    """--force into a folder with foreign content: our entries are moved in one by one (each
+    file atomically), replacing only what an earlier marker of ours lists; files of that
+    earlier result not written again are removed, foreign files and folders never; then the
+    marker (written last) lists what is ours."""
     marker = read_marker(out)
     ours = marker["files"] if marker else set()
-    names = sorted(p.name for p in tmp.iterdir() if p.name != MARKER)
-    clash = [n for n in names if os.path.lexists(out / n) and not _all_ours(out, n, ours)]
+    clash = _clashes(tmp, out, "", ours)
     if clash:
         raise OutputFolderError(f"--out: {out / clash[0]} exists and was not written by this "
                                 f"code; nothing was moved (use another path)")
     new = tree(tmp)
-    for n in names:
-        target = out / n
-        if target.is_dir() and not target.is_symlink():
-            aside = out / f".{n}.old.{os.getpid()}"
-            os.rename(target, aside)
-            os.rename(tmp / n, target)
-            shutil.rmtree(aside, ignore_errors=True)
-        else:
-            os.replace(tmp / n, target)
-        ours = {p for p in ours if p != n and not p.startswith(n + "/")}
-    _write_marker(out, program, ours | new, added_to_existing_folder=True)
-
-
-def _all_ours(out: Path, name: str, ours: set) -> bool:
-    """`name` (top level of out) and, for a folder, everything below it is listed in `ours`."""
-    if name not in ours:
-        return False
-    p = out / name
-    if p.is_dir() and not p.is_symlink():
-        return {f"{name}/{q}" for q in tree(p)} <= ours
-    return True
+    _move_in(tmp, out)
+    for rel in sorted(ours - new, key=lambda q: -q.count("/")):  # deepest first
+        p = out / rel
+        try:
+            if p.is_dir() and not p.is_symlink():
+                p.rmdir()  # only if empty: foreign content keeps it
+            elif os.path.lexists(p):
+                p.unlink()
+        except OSError:
+            pass
+    keep = {q for q in ours | new if os.path.lexists(out / q)}
+    _write_marker(out, program, keep, added_to_existing_folder=True)
 
 
 def _commit(tmp: Path, out: Path, force: bool, program: str):

@@ -113,21 +113,24 @@ def _as_moves(loads, targets):
     return [(loads, targets)]
 
 
-def ramp(problem, bc, target, steps=1, label="ramp", boundary=None):
+def ramp(problem, bc, target, steps=1, label="ramp", boundary=None, names=None):
     """Move one load (or a list of loads) from its current value to `target` (a float, a per-dof
     array, or a list aligned with the loads) in `steps` equal load steps, the others held.
     The reaction reported is the one at `boundary` (default: the boundary of the first moved
-    Dirichlet condition on a named boundary; none if there is no such condition).
+    Dirichlet condition on a named boundary; none if there is no such condition). names: the
+    loads' names in the progress line and the record (default: `describe`).
     Raises ContactSolverError when Newton fails after its cut-backs."""
     moves = _as_moves(bc, target)
+    names = [describe(ld) for ld, _ in moves] if names is None else list(names)
     if boundary is None:
         named = [ld.boundary for ld, _ in moves if _attr(ld) == "value"
                  and isinstance(ld.boundary, str)]
         boundary = named[0] if named else None
     nsteps, its = _move(problem, moves, steps, label)
+    now = [current_value(problem, ld) for ld, _ in moves]
     rec = StageRecord("ramp", label, nsteps, its, boundary=boundary,
-                      values={describe(ld): _record(current_value(problem, ld)) for ld, _ in moves})
-    reached = ", ".join(f"{describe(ld)} = {_fmt(current_value(problem, ld))}" for ld, _ in moves)
+                      values={n: _record(v) for n, v in zip(names, now)})
+    reached = ", ".join(f"{n} = {_fmt(v)}" for n, v in zip(names, now))
     if boundary is not None:
         rec.force = [float(f) for f in problem.reaction(boundary)]
         reached += f"; reaction on {boundary} = [{', '.join(f'{f:.6g}' for f in rec.force)}]"
@@ -136,9 +139,10 @@ def ramp(problem, bc, target, steps=1, label="ramp", boundary=None):
 
 
 def reach_force(problem, bc, boundary, component, target, first_guess, tol=1e-3, max_iter=12,
-                monotone=False, steps=1, label="force"):
+                monotone=False, steps=1, label="force", name=None):
     """Force control: secant iterations on the value of the Dirichlet condition `bc` until the
-    reaction component `component` at `boundary` is within tol |target| of `target`.
+    reaction component `component` at `boundary` is within tol |target| of `target` (name:
+    the condition's name in progress lines and the record, default `describe`).
 
     Each iterate is a stage from the last one (the first in `steps` load steps, the others in
     one), starting from the current value and reaction; `first_guess` is the first value of
@@ -151,7 +155,7 @@ def reach_force(problem, bc, boundary, component, target, first_guess, tol=1e-3,
     target = float(target)
     history = [(current_value(problem, bc), float(problem.reaction(boundary)[component]))]
     value = float(first_guess)
-    name = describe(bc)
+    name = describe(bc) if name is None else name
     nsteps = its = 0
     for k in range(int(max_iter)):
         n, i = _move(problem, [(bc, value)], steps if k == 0 else 1, f"{label} {name}={value:.6g}")

@@ -18,8 +18,9 @@ Boundaries: named facet tags as in the gmsh scenes; names on a cut (non grid-ali
 boundary are kept in Scene.boundaries but mark no facet.
 Generators (same body names/tags, boundary names, pairs and contact boxes as meshes/*.py):
   hertz_cut_scene       block window [-W, W] x [-depth, 0] (no cut cell), cylinder window
-                        [-R, R] x [0, R] cut by Circle((0, R), R); graded grid, spacing h on
-                        [-zone, zone]^2 (zone rounded up to a multiple of h)
+                        [-R, R] x [0, Ry] cut by Circle((0, R), R) (Ry = R, the default) or
+                        Ellipse((0, Ry), R, Ry); graded grid, spacing h on [-zone, zone]^2
+                        (zone rounded up to a multiple of h)
   patch_cut_scene       [0, width] x [0, height] split at y = interface (not a grid line)
   two_blocks_cut_scene  the two blocks, interface y = height mid-cell (ny odd)
   incline_cut_scene     the square cut by y = slope x + intercept
@@ -38,7 +39,7 @@ import ufl
 from dolfinx_forms.cut import CUT, GHOST_FACET, INTERIOR, levelset_values  # noqa: F401
 
 from .hertz import hertz_contact_box
-from .scene import Body, Scene, contact_partitioner, on_box_side, summary, tag_boundaries
+from .scene import Body, Scene, on_box_side, partitioner_kwargs, summary, tag_boundaries
 
 __all__ = ["CutBody", "CutData", "graded_lines", "half_plane", "cut_scene", "levelset_values",
            "hertz_cut_scene", "patch_cut_scene", "two_blocks_cut_scene", "incline_cut_scene",
@@ -233,7 +234,9 @@ def cut_scene(comm, xlines, ylines, bodies, boundary_markers, pairs, h_contact, 
     """Collective: the cut-cell Scene (cell_type "quadrilateral", Scene.cut set) of `bodies`
     (CutBody or (name, tag, window, cut_shape[, bbox]) tuples) on the grid xlines x ylines.
 
-    boundary_markers, pairs, contact_box: as in :func:`meshes.scene.scene_from_gmsh`. Rank 0
+    boundary_markers, pairs, contact_box: as in :func:`meshes.scene.scene_from_gmsh` (no
+    contact_box: derived from the pairs and the bodies' bounding boxes, see
+    :func:`meshes.scene.pairs_contact_boxes`; False: DOLFINx's graph partitioner). Rank 0
     builds the cells and passes them to create_mesh (the other ranks pass empty arrays); the
     body tag and kind of each cell reach the owner and ghosts through
     topology.original_cell_index. ValueError (on every rank) if a window bound is not a grid
@@ -270,9 +273,10 @@ def cut_scene(comm, xlines, ylines, bodies, boundary_markers, pairs, h_contact, 
         x, cells = np.zeros((0, 2)), np.zeros((0, 4), np.int64)
 
     domain = ufl.Mesh(ufl.VectorElement("Lagrange", ufl.quadrilateral, 1))
-    kwargs = {}
-    if contact_box is not None:
-        kwargs["partitioner"] = contact_partitioner(x, cells, "quadrilateral", contact_box)
+    # default contact box: from the pairs and the bodies' bboxes (known on every rank)
+    box_bodies = [Body(b.name, b.tag, None, bbox) for b, bbox in zip(bodies, bboxes)]
+    kwargs = partitioner_kwargs(comm, x, cells, "quadrilateral", contact_box, box_bodies, pairs,
+                                h_contact)
     mesh = dolfinx.mesh.create_mesh(comm, cells, x, domain, ghost_mode=ghost_mode, **kwargs)
 
     tdim = mesh.topology.dim
@@ -313,33 +317,38 @@ def _window_markers(windows, specs, tol):
 
 
 def hertz_cut_scene(comm, R=10.0, width=40.0, depth=20.0, h=0.05, zone=1.5, h_far=None,
-                    growth=1.2, contact_box=None) -> Scene:
+                    growth=1.2, contact_box=None, Ry=None) -> Scene:
     """The Hertz scene of meshes/hertz.py on a graded grid (spacing h on [-z, z]^2, z = zone
-    rounded up to a multiple of h); the block has no cut cell, the cylinder is cut by its circle.
-    contact_box overrides hertz_contact_box(R, width, depth, zone)."""
+    rounded up to a multiple of h); the block has no cut cell, the indenter (window
+    [-R, R] x [0, Ry]) is cut by its circle, or by its ellipse of semi-axes R (horizontal) and Ry
+    (vertical, default R). contact_box overrides hertz_contact_box(R, width, depth, zone, Ry)."""
     import dolfinx_forms as df
 
+    from .hertz import indenter_shape
+
+    Ry = R if Ry is None else float(Ry)
     W = width / 2
     k = zone / h
     z = zone if abs(k - round(k)) < 1e-9 else h * np.ceil(k)
-    if not z < min(R, W, depth):
+    if not z < min(R, Ry, W, depth):
         raise ValueError(f"hertz_cut_scene: zone {z} (rounded up to a multiple of h) must be "
-                         f"< min(R, width/2, depth) = {min(R, W, depth)}")
-    h_far = max(h, min(R, depth) / 8 if h_far is None else h_far)
+                         f"< min(R, Ry, width/2, depth) = {min(R, Ry, W, depth)}")
+    h_far = max(h, min(R, Ry, depth) / 8 if h_far is None else h_far)
     xmax = max(W, R)
     xlines = graded_lines(-xmax, xmax, (-z, z), h, growth, h_far, required=[-W, -R, 0.0, R, W])
-    ylines = graded_lines(-depth, R, (-z, z), h, growth, h_far, required=[0.0])
+    ylines = graded_lines(-depth, Ry, (-z, z), h, growth, h_far, required=[0.0])
     m = max(R, W, depth)  # the block's cut box: the window with a margin, so no cell is cut
     block = np.array([[-W, -depth], [W, 0.0]])
     bodies = [
         CutBody("block", 1, block, df.Box(block[0] - m, block[1] + m), block),
-        CutBody("cylinder", 2, np.array([[-R, 0.0], [R, R]]), df.Circle((0.0, R), R),
-                np.array([[-R, 0.0], [R, R]])),
+        CutBody("cylinder", 2, np.array([[-R, 0.0], [R, Ry]]), indenter_shape(R, Ry),
+                np.array([[-R, 0.0], [R, Ry]])),
     ]
     specs = [("block_bottom", 0, ["bottom"]), ("block_sides", 0, ["left", "right"]),
              ("block_top", 0, ["top"]), ("cylinder_top", 1, ["top"]), ("cylinder_arc", 1, None)]
-    markers = _window_markers([b.window for b in bodies], specs, 1e-8 * max(R, width, depth))
-    box = hertz_contact_box(R, width, depth, zone) if contact_box is None else contact_box
+    markers = _window_markers([b.window for b in bodies], specs,
+                              1e-8 * max(R, Ry, width, depth))
+    box = hertz_contact_box(R, width, depth, zone, Ry) if contact_box is None else contact_box
     return cut_scene(comm, xlines, ylines, bodies, markers, [(0, 1)], h, contact_box=box)
 
 

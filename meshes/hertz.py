@@ -1,19 +1,26 @@
-"""Hertz scene: a half-cylinder resting on a block (plane strain), touching at one point.
+"""Hertz scene: a half-cylinder (or half-ellipse) resting on a block (plane strain), touching
+at one point.
 
 Geometry (any consistent units):
   body 0 "block"    (tag 1): rectangle [-width/2, width/2] x [-depth, 0]
-  body 1 "cylinder" (tag 2): lower half-disc {x^2 + (y-R)^2 <= R^2, y <= R}; flat face y = R
-                             on top (width 2R), its arc touches the block top at the origin.
+  body 1 "cylinder" (tag 2): lower half-ellipse {(x/R)^2 + ((y-Ry)/Ry)^2 <= 1, y <= Ry}, semi-
+                             axis R horizontal and Ry vertical (default Ry = R: the half-disc
+                             of radius R); flat face y = Ry on top (width 2R), its arc touches
+                             the block top at the origin, where its curvature radius is R^2/Ry.
 Both outlines have a vertex at the origin (two distinct vertices, gap 0 there). The arc is a
-gmsh circle arc (nodes exactly on the circle). In the zone |x|, |y| <= zone (both bodies) h is
-an upper bound: every edge of a cell inside the zone is <= 1.05 h. Quads: the zone is a
-structured grid (spacing <= h, ~0.95 h, the origin a grid vertex), the rest is meshed at 2h,
-recombined and subdivided (all quads); triangles: unstructured with gmsh target ~0.75 h (mean
-edge ~0.75 h), shrunk and remeshed if an edge exceeds 1.05 h.
-Outside the zone the size grows linearly with slope 0.25 up to h_far (default min(R, depth)/8).
+gmsh circle arc (Ry = R) or ellipse arc (nodes exactly on the circle / ellipse). In the zone
+|x|, |y| <= zone (both bodies) h is an upper bound: every edge of a cell inside the zone is
+<= 1.05 h. Quads: the zone is a structured grid (spacing <= h, ~0.95 h, the origin a grid
+vertex), the rest is meshed at 2h, recombined and subdivided (all quads); triangles:
+unstructured with gmsh target ~0.75 h (mean edge ~0.75 h), shrunk and remeshed if an edge
+exceeds 1.05 h.
+Outside the zone the size grows linearly with slope 0.25 up to h_far (default
+min(R, Ry, depth)/8). The zone must lie inside both bodies: zone < min(R, Ry, width/2, depth),
+and the arc below y = zone at x = +-zone.
 Boundaries (facet tags): block_bottom=1, block_sides=2, block_top=3, cylinder_top=4, cylinder_arc=5.
 pairs = [(0, 1)]; the contact box [-1.5 zone, 1.5 zone]^2 (clipped to the scene) is on rank 0.
-Run: /usr/bin/python3 -m meshes.hertz [--h 0.05] [--quads]   (from the repository root)
+Run: /usr/bin/python3 -m meshes.hertz [--h 0.05] [--quads] [--R 10] [--Ry 6]
+     (from the repository root)
 """
 
 from __future__ import annotations
@@ -25,22 +32,43 @@ from .scene import Body, Scene, extract_gmsh, gmsh_model, max_edge_in_box, scene
 GROWTH = 0.25  # mesh size slope outside the zone
 
 
-def hertz_contact_box(R=10.0, width=40.0, depth=20.0, zone=1.5) -> np.ndarray:
-    """[-1.5 zone, 1.5 zone]^2 clipped to the bounding box of the two bodies."""
-    z = 1.5 * zone
-    return np.array([[max(-z, -width / 2), max(-z, -depth)], [min(z, width / 2), min(z, R)]])
+def hertz_contact_box(R=10.0, width=40.0, depth=20.0, zone=1.5, Ry=None) -> np.ndarray:
+    """[-1.5 zone, 1.5 zone]^2 clipped to the bounding box of the two bodies (Ry: the
+    indenter's vertical semi-axis, default R)."""
+    z, top = 1.5 * zone, R if Ry is None else Ry
+    return np.array([[max(-z, -width / 2), max(-z, -depth)], [min(z, width / 2), min(z, top)]])
 
 
-def _build(gmsh, R, W, depth, z, h, h_far, quads):
+def ellipse_sag(R, Ry, x):
+    """Height of the arc above its lowest point at abscissa x: Ry (1 - sqrt(1 - (x/R)^2)) (the
+    initial gap to the block top; R - sqrt(R^2 - x^2) for the circle Ry = R)."""
+    if Ry == R:
+        return R - np.sqrt(R * R - x * x)
+    return Ry * (1 - np.sqrt(1 - (x / R) ** 2))
+
+
+def _arc_length(R, Ry, x):
+    """Length of the arc from its lowest point to abscissa x (0 <= x < R)."""
+    t1 = np.arcsin(x / R)  # parameter of (R sin t, Ry (1 - cos t))
+    if Ry == R:
+        return R * t1
+    s, w = np.polynomial.legendre.leggauss(64)
+    t = 0.5 * t1 * (s + 1)
+    return 0.5 * t1 * float(np.sum(w * np.hypot(R * np.cos(t), Ry * np.sin(t))))
+
+
+def _build(gmsh, R, W, depth, z, h, h_far, quads, Ry=None):
     """Rank 0: both bodies, each split into a zone part (|x|, |y| <= z) and the rest (shared
     curves inside a body only), then meshed. quads: the zone parts are structured (transfinite)
-    grids with edges <= h, the rest is recombined. Triangles: unstructured everywhere."""
-    assert 0 < z < min(R, W, depth), "zone must lie inside both bodies"
-    geo, sag = gmsh.model.geo, R - np.sqrt(R * R - z * z)
+    grids with edges <= h, the rest is recombined. Triangles: unstructured everywhere.
+    Ry: vertical semi-axis of the indenter (default R, the circle)."""
+    Ry = R if Ry is None else Ry
+    geo, sag = gmsh.model.geo, ellipse_sag(R, Ry, z)
+    assert 0 < z < min(R, Ry, W, depth) and sag < z, "zone must lie inside both bodies"
     # quads: blossom may leave a few triangles, so mesh at 2h and subdivide every cell (all quads,
     # the structured zone stays structured): zone curves get n/2 cells before subdivision
     hq = 2 * h if quads else h
-    n_x = int(np.ceil(R * np.arcsin(z / R) / hq))  # cells along each half (x < 0, x > 0)
+    n_x = int(np.ceil(_arc_length(R, Ry, z) / hq))  # cells along each half (x < 0, x > 0)
     n_y = int(np.ceil(z / hq))  # cells across the zone's height: z (block), z - sag .. z (cylinder)
 
     def pts(*xy):
@@ -67,9 +95,14 @@ def _build(gmsh, R, W, depth, z, h, h_far, quads):
     surface([-zb_r, -down, top_r, -mid], True)
     surface([-zb_l, mid, top_l, -up], True)
     # cylinder: the zone part {|x| <= z, y <= z} above the arc (two halves), and the rest
-    c, a, pl, o2, pr, b, ztl, ztm, ztr = pts((0, R), (-R, R), (-z, sag), (0, 0), (z, sag), (R, R),
-                                             (-z, z), (0, z), (z, z))
-    arcs = [geo.addCircleArc(p, c, q) for p, q in [(a, pl), (pl, o2), (o2, pr), (pr, b)]]
+    c, a, pl, o2, pr, b, ztl, ztm, ztr = pts((0, Ry), (-R, Ry), (-z, sag), (0, 0), (z, sag),
+                                             (R, Ry), (-z, z), (0, z), (z, z))
+    if Ry == R:
+        arcs = [geo.addCircleArc(p, c, q) for p, q in [(a, pl), (pl, o2), (o2, pr), (pr, b)]]
+    else:  # the major-axis point: (R, Ry) on the horizontal axis, else the origin (vertical)
+        major = b if R > Ry else o2
+        arcs = [geo.addEllipseArc(p, c, major, q)
+                for p, q in [(a, pl), (pl, o2), (o2, pr), (pr, b)]]
     side_l, zt_l, zt_r, side_r = lines([pl, ztl, ztm, ztr, pr], closed=False)
     top, cmid = geo.addLine(b, a), geo.addLine(o2, ztm)
     surface([arcs[0], side_l, zt_l, zt_r, side_r, arcs[3], top])
@@ -106,33 +139,50 @@ def _build(gmsh, R, W, depth, z, h, h_far, quads):
         raise RuntimeError(f"hertz: longest edge in the zone is {ratio:.3f} h after 5 meshings")
 
 
-def hertz_scene(comm, R=10.0, width=40.0, depth=20.0, h=0.05, zone=1.5, h_far=None,
-                quads=False, contact_box=None) -> Scene:
-    """The Hertz scene (see the module docstring); contact_box overrides hertz_contact_box()."""
+def indenter_shape(R, Ry):
+    """The indenter's full ellipse (circle if Ry == R) centred at (0, Ry): a dolfinx_forms
+    shape, < 0 inside, its signed distance exact."""
     import dolfinx_forms as df
 
-    h_far = max(h, min(R, depth) / 8 if h_far is None else h_far)
+    return df.Circle((0.0, R), R) if Ry == R else df.Ellipse((0.0, Ry), R, Ry)
+
+
+def hertz_scene(comm, R=10.0, width=40.0, depth=20.0, h=0.05, zone=1.5, h_far=None,
+                quads=False, contact_box=None, Ry=None) -> Scene:
+    """The Hertz scene (see the module docstring): a half-ellipse of semi-axes R (horizontal)
+    and Ry (vertical, default R: the half-cylinder) on the block; contact_box overrides
+    hertz_contact_box()."""
+    import dolfinx_forms as df
+
+    Ry = R if Ry is None else float(Ry)
+    h_far = max(h, min(R, Ry, depth) / 8 if h_far is None else h_far)
     W = width / 2
     bodies = [
         Body("block", 1, df.Box((-W, -depth), (W, 0.0)), np.array([[-W, -depth], [W, 0.0]])),
         Body(
             "cylinder", 2,
-            df.Intersection([df.Circle((0.0, R), R), df.Box((-R - 1, -1.0), (R + 1, R))]),
-            np.array([[-R, 0.0], [R, R]]),
+            df.Intersection([indenter_shape(R, Ry), df.Box((-R - 1, -1.0), (R + 1, Ry))]),
+            np.array([[-R, 0.0], [R, Ry]]),
         ),
     ]
-    tol = 1e-8 * max(R, width, depth)
+    tol = 1e-8 * max(R, Ry, width, depth)
+    if Ry == R:
+        def on_arc(x):
+            return np.abs(np.hypot(x[0], x[1] - R) - R) < tol
+    else:  # |algebraic distance| scaled by the smaller semi-axis (<= the true distance)
+        def on_arc(x):
+            return np.abs(np.hypot(x[0] / R, (x[1] - Ry) / Ry) - 1) * min(R, Ry) < tol
     markers = {
         "block_bottom": (1, lambda x: np.isclose(x[1], -depth, atol=tol), 0),
         "block_sides": (2, lambda x: np.isclose(np.abs(x[0]), W, atol=tol), 0),
         "block_top": (3, lambda x: np.isclose(x[1], 0.0, atol=tol), 0),
-        "cylinder_top": (4, lambda x: np.isclose(x[1], R, atol=tol), 1),
-        "cylinder_arc": (5, lambda x: np.abs(np.hypot(x[0], x[1] - R) - R) < tol, 1),
+        "cylinder_top": (4, lambda x: np.isclose(x[1], Ry, atol=tol), 1),
+        "cylinder_arc": (5, on_arc, 1),
     }
     with gmsh_model(comm, "hertz") as gmsh:
         if comm.rank == 0:
-            _build(gmsh, R, W, depth, zone, h, h_far, quads)
-        box = hertz_contact_box(R, width, depth, zone) if contact_box is None else contact_box
+            _build(gmsh, R, W, depth, zone, h, h_far, quads, Ry)
+        box = hertz_contact_box(R, width, depth, zone, Ry) if contact_box is None else contact_box
         return scene_from_gmsh(comm, bodies, markers, [(0, 1)], h, contact_box=box)
 
 
@@ -144,7 +194,9 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--h", type=float, default=0.05)
     ap.add_argument("--quads", action="store_true")
+    ap.add_argument("--R", type=float, default=10.0, help="horizontal semi-axis")
+    ap.add_argument("--Ry", type=float, default=None, help="vertical semi-axis (default R)")
     args = ap.parse_args()
-    line = summary(hertz_scene(MPI.COMM_WORLD, h=args.h, quads=args.quads))
+    line = summary(hertz_scene(MPI.COMM_WORLD, R=args.R, h=args.h, quads=args.quads, Ry=args.Ry))
     if MPI.COMM_WORLD.rank == 0:
         print("hertz:", line)

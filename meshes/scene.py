@@ -13,9 +13,12 @@ Usage inside a generator (gmsh runs on rank 0 only)::
         scene = scene_from_gmsh(comm, bodies, markers, pairs, h_contact, contact_box)
     return scene
 
-Parallel layout: with a ``contact_box`` every cell whose vertex bounding box intersects the
-box is owned by rank 0 (a Python cell partitioner, see :func:`contact_partitioner`); the rest
-is split geometrically. Without a box, DOLFINx's default graph partitioner is used.
+Parallel layout: every cell whose vertex bounding box intersects the contact box is owned by
+rank 0, where the contact geometry is computed (a Python cell partitioner, see
+:func:`contact_partitioner`); the rest is split geometrically. Without an explicit
+``contact_box`` the box is derived from the contact pairs (:func:`pairs_contact_boxes`: the
+overlap of each pair's bounding boxes inflated by CONTACT_BOX_MARGIN h_contact, one box per
+pair); ``contact_box=False`` selects DOLFINx's default graph partitioner (no contact on rank 0).
 """
 
 from __future__ import annotations
@@ -35,7 +38,13 @@ if TYPE_CHECKING:
 
 __all__ = ["Body", "Scene", "scene_from_gmsh", "gmsh_model", "contact_partitioner", "cell_bboxes",
            "add_polygon", "on_box_side", "summary", "cell_edges", "max_edge_in_box", "extract_gmsh",
-           "tag_boundaries"]
+           "tag_boundaries", "pairs_contact_boxes", "partitioner_kwargs", "CONTACT_BOX_MARGIN"]
+
+# Default contact box: each pair's bbox overlap inflated by this many h_contact. The contact
+# search (dolfinx_forms.contact) covers the overlap inflated by band + h_contact (default band
+# 2 h_contact) and locates closest points up to h_contact / 2 outside a cell: 4 covers it. A
+# larger band needs an explicit contact_box.
+CONTACT_BOX_MARGIN = 4.0
 
 
 @dataclass
@@ -194,19 +203,49 @@ def _facet_neighbours(cells: np.ndarray, cell_name: str) -> tuple[np.ndarray, np
     return owner[pair_start[0]], owner[pair_start[1]]
 
 
+def pairs_contact_boxes(bodies, pairs, h_contact, margin=CONTACT_BOX_MARGIN) -> np.ndarray:
+    """Boxes (k, 2, 2) whose union holds every contact: for each pair (i, j) whose bounding
+    boxes, inflated by margin h_contact, overlap, that overlap (k = 0: no pair can touch)."""
+    d = float(margin) * float(h_contact)
+    boxes = []
+    for i, j in pairs:
+        bi, bj = (np.asarray(bodies[k].bbox, float) for k in (i, j))
+        lo = np.maximum(bi[0], bj[0]) - d
+        hi = np.minimum(bi[1], bj[1]) + d
+        if np.all(lo < hi):
+            boxes.append([lo, hi])
+    return np.array(boxes, dtype=float).reshape(-1, 2, 2)
+
+
+def partitioner_kwargs(comm, x, cells, cell_name, contact_box, bodies, pairs, h_contact) -> dict:
+    """create_mesh keyword arguments: the contact partitioner for `contact_box` ((2, 2) or
+    (k, 2, 2)); None: boxes from the pairs (in parallel only; nothing to do on one rank);
+    False: none (DOLFINx's graph partitioner). Same result on every rank (bodies, pairs and
+    h_contact are collective data)."""
+    if contact_box is False:
+        return {}
+    if contact_box is None:
+        if comm.size == 1:
+            return {}
+        contact_box = pairs_contact_boxes(bodies, pairs, h_contact)
+        if len(contact_box) == 0:
+            return {}
+    return {"partitioner": contact_partitioner(x, cells, cell_name, contact_box)}
+
+
 def contact_partitioner(x: np.ndarray, cells: np.ndarray, cell_name: str, contact_box):
     """A DOLFINx cell partitioner (comm, nparts, tdim, cells, ghost_mode) -> AdjacencyList_int32.
 
     `x`, `cells` are the arrays given to create_mesh on this rank (all of them on rank 0, empty
     elsewhere); the partitioner receives the cells in that order. Cells whose vertex bbox
-    intersects `contact_box` go to rank 0, topped up with the cells nearest to the box up to an
-    equal share; the rest is cut into equal chunks along the longest axis of the bounding box
-    for ranks 1..nparts-1. GhostMode.none: one destination per cell; shared_facet (and
-    shared_vertex, treated alike): owner first, then the owners of its edge neighbours (the
-    ranks that must hold it as a ghost). If the box holds more than 1/nparts of the cells,
-    rank 0 simply gets more than its share.
+    intersects `contact_box` ((2, 2), or (k, 2, 2): a union of boxes) go to rank 0, topped up
+    with the cells nearest to the box up to an equal share; the rest is cut into equal chunks
+    along the longest axis of the bounding box for ranks 1..nparts-1. GhostMode.none: one
+    destination per cell; shared_facet (and shared_vertex, treated alike): owner first, then
+    the owners of its edge neighbours (the ranks that must hold it as a ghost). If the box
+    holds more than 1/nparts of the cells, rank 0 simply gets more than its share.
     """
-    box = np.asarray(contact_box, dtype=float)
+    boxes = np.asarray(contact_box, dtype=float).reshape(-1, 2, 2)
     AdjacencyList_int32 = dolfinx.cpp.graph.AdjacencyList_int32
 
     def partition(comm, nparts, tdim, graph, ghost_mode):
@@ -218,12 +257,17 @@ def contact_partitioner(x: np.ndarray, cells: np.ndarray, cell_name: str, contac
         if nparts > 1:
             lo, hi = cell_bboxes(x, cells)
             centroid = 0.5 * (lo + hi)
-            hit = np.all((lo <= box[1]) & (hi >= box[0]), axis=1)
+            hit = np.zeros(n, bool)
+            for box in boxes:
+                hit |= np.all((lo <= box[1]) & (hi >= box[0]), axis=1)
             rest = np.flatnonzero(~hit)
-            # rank 0 tops up to an equal share with the cells nearest to the box
+            # rank 0 tops up to an equal share with the cells nearest to the boxes
             n0 = max(0, -(-n // nparts) - int(hit.sum()))
             c = centroid[rest]
-            d = np.linalg.norm(np.maximum(0.0, np.maximum(box[0] - c, c - box[1])), axis=1)
+            d = np.full(len(rest), np.inf)
+            for box in boxes:
+                d = np.minimum(d, np.linalg.norm(np.maximum(0.0, np.maximum(box[0] - c,
+                                                                           c - box[1])), axis=1))
             near = np.argsort(d, kind="stable")
             others = rest[near[n0:]]
             axis = int(np.argmax(np.ptp(centroid[others], axis=0))) if len(others) else 0
@@ -307,7 +351,9 @@ def scene_from_gmsh(comm, bodies, boundary_markers, pairs, h_contact, contact_bo
     shape (3, n) -> bool (all facet vertices must pass, as in locate_entities_boundary); `body`
     (index into `bodies` or its name) restricts the name to facets of that body's cells, needed
     where two bodies have coincident facets. A facet gets the first matching name (dict order).
-    contact_box: (2, 2) [[xmin, ymin], [xmax, ymax]] whose cells are all owned by rank 0, or None.
+    contact_box: (2, 2) [[xmin, ymin], [xmax, ymax]] (or (k, 2, 2), a union of boxes) whose
+    cells are all owned by rank 0; None (default): derived from the pairs and the bodies' bboxes
+    (:func:`pairs_contact_boxes`); False: DOLFINx's graph partitioner.
     """
     status = None
     if comm.rank == 0:
@@ -325,9 +371,7 @@ def scene_from_gmsh(comm, bodies, boundary_markers, pairs, h_contact, contact_bo
         x, cells = np.zeros((0, 2)), np.zeros((0, nv), np.int64)
 
     domain = dolfinx.io.gmshio.ufl_mesh(gtype, 2)
-    kwargs = {}
-    if contact_box is not None:
-        kwargs["partitioner"] = contact_partitioner(x, cells, cell_name, contact_box)
+    kwargs = partitioner_kwargs(comm, x, cells, cell_name, contact_box, bodies, pairs, h_contact)
     mesh = dolfinx.mesh.create_mesh(comm, cells, x, domain, ghost_mode=ghost_mode, **kwargs)
 
     # cell tags: the body whose shape is most negative at the centroid (owned + ghost cells)

@@ -1,8 +1,30 @@
-"""Make the in-tree package importable when pytest runs from the repository root."""
+"""Test set-up. The packages (dolfinx_forms, meshes) are imported like any installed package:
+from PYTHONPATH (`make test` exports the repository root) or from a pip installation; nothing
+here changes sys.path.
 
-import sys
+Tests start demos and mpirun in subprocesses, which inherit os.environ. When this process
+found the packages in a source tree that PYTHONPATH does not name (`/usr/bin/python3 -m pytest`
+from the repository root puts the current folder on sys.path), that tree is added to
+PYTHONPATH here, so the children import the same code as the tests.
+"""
+
+import importlib.util
+import os
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+
+def _source_tree():
+    spec = importlib.util.find_spec("dolfinx_forms")
+    if spec is None or spec.origin is None:
+        return None
+    root = Path(spec.origin).resolve().parents[1]
+    return root if (root / "pyproject.toml").is_file() and (root / "meshes").is_dir() else None
+
+
+def pytest_configure(config):
+    root = _source_tree()
+    if root is None:
+        return
+    parts = [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+    if str(root) not in {str(Path(p).resolve()) for p in parts}:
+        os.environ["PYTHONPATH"] = os.pathsep.join([str(root), *parts])

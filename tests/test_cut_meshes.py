@@ -7,7 +7,6 @@ import os
 import shutil
 import subprocess
 import sys
-from pathlib import Path
 
 import dolfinx
 import dolfinx.cpp
@@ -16,10 +15,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-if __name__ == "__main__":  # run by mpirun from test_two_ranks_match_one_rank
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from meshes.cut import (  # noqa: E402
+from meshes.cut import (
     CUT,
     INTERIOR,
     CutBody,
