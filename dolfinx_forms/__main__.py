@@ -21,17 +21,27 @@ PROG = "python3 -m dolfinx_forms"
 def parse(argv):
     p = DemoParser(prog=PROG, description=__doc__.split("\n\n")[0])
     sub = p.add_subparsers(dest="command", required=True, parser_class=DemoParser)
-    for name, what in (("run", "run a scene and write its results"),
-                       ("check", "check a scene description without running it")):
+    for name, what in (
+        ("run", "run a scene and write its results"),
+        ("check", "check a scene description without running it"),
+    ):
         s = sub.add_parser(name, help=what, description=what)
         s.add_argument("scene", help="scene description (TOML)")
-        s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                       help="change one value of the description (repeatable)")
+        s.add_argument(
+            "--set",
+            action="append",
+            default=[],
+            metavar="KEY=VALUE",
+            help="change one value of the description (repeatable)",
+        )
         if name == "run":
             s.add_argument("--out", default=None, help="result folder (default results/NAME)")
-            s.add_argument("--force", action="store_true",
-                           help="write into an existing folder that is not a result folder "
-                                "of this code (nothing there is deleted)")
+            s.add_argument(
+                "--force",
+                action="store_true",
+                help="write into an existing folder that is not a result folder "
+                "of this code (nothing there is deleted)",
+            )
     return p, p.parse_args(argv)
 
 
@@ -46,15 +56,22 @@ def main(argv=None):
 
             spec = load(args.scene, args.set)
             if rank0:
-                print(f"{args.scene}: {spec['name']}, {len(spec['bodies'])} bodies, "
-                      f"{len(spec['stages'])} stages, {len(spec['checks'])} checks: ok")
+                print(
+                    f"{args.scene}: {spec['name']}, {len(spec['bodies'])} bodies, "
+                    f"{len(spec['stages'])} stages, {len(spec['checks'])} checks: ok"
+                )
             return 0
         from .newton import ContactSolverError
         from .runner import run
 
         try:
-            result = run(args.scene, args.out, overrides=args.set, force=args.force,
-                         log=print if rank0 else (lambda *a, **k: None))
+            result = run(
+                args.scene,
+                args.out,
+                overrides=args.set,
+                force=args.force,
+                log=print if rank0 else (lambda *a, **k: None),
+            )
         except ContactSolverError as e:
             if rank0:
                 sys.stderr.write(f"{PROG}: {e}\n")

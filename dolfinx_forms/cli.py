@@ -16,8 +16,10 @@ import sys
 from .folders import OutputFolderError, check_output_path
 from .logs import set_verbose
 
-FORCE_HELP = ("write into an existing folder that is not a result folder of this code, adding "
-              "the results next to its content (nothing there is deleted or overwritten)")
+FORCE_HELP = (
+    "write into an existing folder that is not a result folder of this code, adding "
+    "the results next to its content (nothing there is deleted or overwritten)"
+)
 
 
 class DefaultsFormatter(argparse.HelpFormatter):
@@ -25,8 +27,11 @@ class DefaultsFormatter(argparse.HelpFormatter):
 
     @staticmethod
     def _shows_default(action):
-        return (bool(action.option_strings) and action.nargs != 0
-                and action.default not in (None, [], argparse.SUPPRESS, ""))
+        return (
+            bool(action.option_strings)
+            and action.nargs != 0
+            and action.default not in (None, [], argparse.SUPPRESS, "")
+        )
 
     def _format_action(self, action):
         if not action.help and self._shows_default(action):
@@ -49,8 +54,11 @@ class DemoParser(argparse.ArgumentParser):
         kwargs.setdefault("formatter_class", DefaultsFormatter)
         super().__init__(*args, **kwargs)
         self._out_dest = None
-        self.add_argument("--verbose", action="store_true",
-                          help="show the JIT compiler's log lines (also: ILS_VERBOSE=1)")
+        self.add_argument(
+            "--verbose",
+            action="store_true",
+            help="show the JIT compiler's log lines (also: ILS_VERBOSE=1)",
+        )
 
     def add_out(self, default, help="result folder (replaced atomically)"):
         """--out DIR (checked while parsing, see folders.py) and --force."""
@@ -87,9 +95,11 @@ def bounded(name, lo=None, hi=None, lo_open=False, hi_open=False):
             x = float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{name} must be a number in {rng()}, got {text!r}")
-        bad = (not math.isfinite(x)
-               or (lo is not None and (x <= lo if lo_open else x < lo))
-               or (hi is not None and (x >= hi if hi_open else x > hi)))
+        bad = (
+            not math.isfinite(x)
+            or (lo is not None and (x <= lo if lo_open else x < lo))
+            or (hi is not None and (x >= hi if hi_open else x > hi))
+        )
         if bad:
             raise argparse.ArgumentTypeError(f"{name} must be in {rng()}, got {text}")
         return x
@@ -111,10 +121,18 @@ def petsc_options(parser, items):
 
 def add_discretization(parser):
     """--discretization and the cut path's --ghost-penalty (shared by every demo)."""
-    parser.add_argument("--discretization", choices=["conforming", "cut"], default="conforming",
-                        help="body-fitted gmsh meshes, or level sets cutting a structured grid")
-    parser.add_argument("--ghost-penalty", type=bounded("--ghost-penalty", 0, None), default=0.01,
-                        help="cut path: ghost-penalty factor on the faces of cut cells (0: off)")
+    parser.add_argument(
+        "--discretization",
+        choices=["conforming", "cut"],
+        default="conforming",
+        help="body-fitted gmsh meshes, or level sets cutting a structured grid",
+    )
+    parser.add_argument(
+        "--ghost-penalty",
+        type=bounded("--ghost-penalty", 0, None),
+        default=0.01,
+        help="cut path: ghost-penalty factor on the faces of cut cells (0: off)",
+    )
 
 
 def check_discretization(parser, args):

@@ -5,10 +5,14 @@ the reference configuration; Newton only changes u in the gaps (eqs 27-30). For 
 
 1. the pair's *search box*: the overlap of the two bodies' bounding boxes, each inflated by
    the contact band. Pairs whose inflated boxes do not overlap are never searched.
-2. a structured grid on that box and each body's level set sampled on it (exact signed
-   distance of the body's shape, C1 interpolation by the geometry core);
-3. Gamma_c (eqs 21-24) with Gauss points, normals n (body i -> j), tangents t;
-4. closest points P_i, P_j (eq 25), g_n0 = (P_j - P_i).n (eq 28);
+2. a structured grid on that box and each body's level set on it (`body_levelset`: the
+   exact signed distance of the body's shape sampled at the nodes, or, for a body given by a
+   grid level set, that level set's C1 interpolant there);
+3. Gamma_c (eqs 21-24, `_cpp.contact_surface`) with Gauss points, normals n (body i -> j),
+   tangents t;
+4. closest points P_i, P_j (eq 25, `closest_points`: exact on a body's analytic shape, the
+   iteration of eq 25 on the grid level set for a body without one), g_n0 = (P_j - P_i).n
+   (eq 28, `_cpp.compute_gaps` in the reference configuration);
 5. the mesh cells containing P_i and P_j (binned point location in C++; on a cut scene's
    structured grid, index arithmetic) and the basis values there (basix), packed into a
    `ContactQuadrature` for the C++ kernel (eq 48).
@@ -46,6 +50,39 @@ def search_box(body_i, body_j, band):
     if np.any(lo >= hi):
         return None
     return np.array([lo, hi])
+
+
+def has_exact_shape(body):
+    """True if the body's shape is an analytic signed distance (`_cpp.Shape`); False for a body
+    given by a grid level set (`_cpp.LevelSet`), e.g. one built from a polyline or evolved."""
+    return isinstance(body.shape, _cpp.Shape)
+
+
+def body_levelset(grid, body):
+    """The body's level set on `grid`: its exact shape sampled at the nodes, or, for a body given
+    by a grid level set, that level set's C1 interpolant evaluated at the nodes (ValueError if
+    its grid does not cover `grid`)."""
+    if has_exact_shape(body):
+        return _cpp.levelset_from_shape(grid, body.shape)
+    if not isinstance(body.shape, _cpp.LevelSet):
+        raise TypeError(f"body {body.name!r}: shape must be a Shape or a LevelSet, "
+                        f"got {type(body.shape).__name__}")
+    try:
+        values, _ = body.shape.evaluate(grid.nodes())
+    except IndexError as e:
+        raise ValueError(f"body {body.name!r}: its level-set grid does not cover the contact "
+                         f"search box ({e})") from None
+    return _cpp.LevelSet(grid, values)
+
+
+def closest_points(body, phi, points, length_scale, exact=True):
+    """Closest points on the boundary of `body` (eq 25) of (n, 2) `points`, as the dict of
+    `_cpp.closest_point_projection`. With `exact` and an analytic shape: exact closest points
+    on the shape (corners included); otherwise the iteration of eq 25 on the grid level set
+    `phi` (the body's level set on the pair grid, `body_levelset`)."""
+    if exact and has_exact_shape(body):
+        return _cpp.closest_point_projection(body.shape, points, length_scale)
+    return _cpp.closest_point_projection(phi, points)
 
 
 def _basix_element(cell_type, degree):
@@ -130,15 +167,17 @@ class GridLocator:
 
 
 def pair_geometry(V, scene, pair, band, *, grid_refine=4, num_gauss=2, max_outside=None,
-                  projection="shape"):
+                  projection="auto"):
     """Contact quadrature of `pair` (indices into scene.bodies).
 
     band: largest initial gap covered by Gamma_c (eq 22 uses eps = band / 2), a length.
     grid_refine: level-set grid cells per mesh size h_contact.
-    projection: "shape" (exact closest points on the bodies' analytic shapes) or "levelset"
-    (eq 25 on the grid interpolants).
+    projection: "auto" (exact closest points on a body's analytic shape, eq 25 on the grid
+    level set for a body without one) or "levelset" (eq 25 on the grid level sets for both).
     Returns None when the pair cannot touch (disjoint inflated boxes or empty Gamma_c).
     """
+    if projection not in ("auto", "levelset"):
+        raise ValueError(f"projection must be 'auto' or 'levelset', got {projection!r}")
     i, j = pair
     bi, bj = scene.bodies[i], scene.bodies[j]
     h = scene.h_contact
@@ -150,8 +189,7 @@ def pair_geometry(V, scene, pair, band, *, grid_refine=4, num_gauss=2, max_outsi
     hi = box[0] + n * dx  # keep the spacing exactly dx
     grid = _cpp.StructuredGrid(np.linspace(box[0, 0], hi[0], n[0] + 1),
                                np.linspace(box[0, 1], hi[1], n[1] + 1))
-    phi_i = _cpp.levelset_from_shape(grid, bi.shape)
-    phi_j = _cpp.levelset_from_shape(grid, bj.shape)
+    phi_i, phi_j = body_levelset(grid, bi), body_levelset(grid, bj)
     s = _cpp.contact_surface(phi_i, phi_j, 0.5 * band, num_gauss)
     # Gamma_c through level-set grid nodes leaves zero-length segments: drop their points
     keep = s["weights"] > 1e-9 * dx
@@ -159,10 +197,8 @@ def pair_geometry(V, scene, pair, band, *, grid_refine=4, num_gauss=2, max_outsi
          for k, v in s.items()}
     if len(s["weights"]) == 0:
         return None
-    if projection == "shape":  # exact shapes: exact closest points, corners included
-        proj = [_cpp.closest_point_projection(b.shape, s["points"], h) for b in (bi, bj)]
-    else:  # eq 25 on the level-set interpolant (first order at corners)
-        proj = [_cpp.closest_point_projection(phi, s["points"]) for phi in (phi_i, phi_j)]
+    proj = [closest_points(b, phi, s["points"], h, exact=projection == "auto")
+            for b, phi in ((bi, phi_i), (bj, phi_j))]
     for name, pr in zip((bi.name, bj.name), proj):
         if not np.all(pr["converged"]):
             bad = np.flatnonzero(~pr["converged"])[0]
@@ -171,7 +207,8 @@ def pair_geometry(V, scene, pair, band, *, grid_refine=4, num_gauss=2, max_outsi
                 f"{s['points'][bad]} (status {_cpp.ProjectionStatus(int(pr['status'][bad])).name})")
     p_i, p_j = proj[0]["points"], proj[1]["points"]
     normals, tangents = s["normals"], s["tangents"]
-    g_n0 = np.einsum("ij,ij->i", p_j - p_i, normals)
+    zero = np.zeros_like(p_i)  # reference configuration: g_n = g_n0 (eq 28)
+    g_n0 = _cpp.compute_gaps(p_i, p_j, zero, zero, normals, tangents)["g_n0"]
 
     degree = V.ufl_element().degree()
     dofmap = V.dofmap.list.array.reshape(-1, V.dofmap.dof_layout.num_dofs)

@@ -4,15 +4,17 @@ Every result folder holds a marker file MARKER (`.ils_result`, JSON: the program
 the relative paths of every file and folder it wrote). Rules for `--out PATH`:
 
 * PATH missing: the results appear there in one rename of a finished temporary folder.
-* PATH an empty folder, or a result folder of this code holding nothing but what its marker
-  lists: replaced in one atomic exchange (renameat2 RENAME_EXCHANGE; two renames where the
-  filesystem lacks it), then the old results are removed.
+* PATH an empty folder: replaced by one rename. PATH a result folder of this code holding
+  nothing but what its marker lists: replaced in one atomic exchange (renameat2
+  RENAME_EXCHANGE; two renames where the filesystem lacks it), then the old results removed.
 * PATH holds anything else (no marker, or files the marker does not list): refused with
   ``--out: PATH exists and is not a result folder of this code (use another path or --force)``,
   exit status 2, when the arguments are parsed (before any computation) and again before the
-  results are moved in. With ``--force`` our files are added next to what is there, each
-  file replaced atomically; files and folders the marker does not list are never deleted or
-  overwritten (a name clash is an error and nothing is moved).
+  results are moved in. With ``--force`` our files are added next to what is there (existing
+  folders merged, each file moved in atomically, the marker written last); files of an
+  earlier result of ours that are not written again are removed; files and folders the
+  marker does not list are never deleted or overwritten (a name clash is an error and
+  nothing is moved).
 * PATH a file, '' or '.', the current folder or one of its parents, the filesystem root or
   the home folder: always refused.
 
@@ -35,9 +37,19 @@ from pathlib import Path
 MARKER = ".ils_result"
 # names the programs of this repository write at the top of a result folder: with --force a
 # foreign entry of one of these names is refused when the arguments are parsed
-RESULT_NAMES = ("metrics.json", "tractions.csv", "tractions.png", "solution.xdmf", "solution.h5",
-                "contact_points.csv", "contact_geometry.png", "convergence.json",
-                "convergence.png", "runs", MARKER)
+RESULT_NAMES = (
+    "metrics.json",
+    "tractions.csv",
+    "tractions.png",
+    "solution.xdmf",
+    "solution.h5",
+    "contact_points.csv",
+    "contact_geometry.png",
+    "convergence.json",
+    "convergence.png",
+    "runs",
+    MARKER,
+)
 
 
 class OutputFolderError(ValueError):
@@ -123,7 +135,9 @@ def _forbidden(text: str, path: Path):
 
 
 def _not_ours(out: Path) -> str:
-    return f"--out: {out} exists and is not a result folder of this code (use another path or --force)"
+    return (
+        f"--out: {out} exists and is not a result folder of this code (use another path or --force)"
+    )
 
 
 def check_output_path(text, force=False) -> Path:
@@ -147,11 +161,18 @@ def check_output_path(text, force=False) -> Path:
             raise OutputFolderError(_not_ours(out))
         marker = read_marker(out)
         ours = marker["files"] if marker else set()
-        clash = sorted(n for n in RESULT_NAMES if os.path.lexists(out / n) and n not in ours
-                       and not (n == MARKER and marker is not None))
+        clash = sorted(
+            n
+            for n in RESULT_NAMES
+            if os.path.lexists(out / n)
+            and n not in ours
+            and not (n == MARKER and marker is not None)
+        )
         if clash:
-            raise OutputFolderError(f"--out: {out} holds {clash[0]!r}, which this code did not "
-                                    f"write and would overwrite (use another path)")
+            raise OutputFolderError(
+                f"--out: {out} holds {clash[0]!r}, which this code did not "
+                f"write and would overwrite (use another path)"
+            )
     anc = out if state != "missing" else out.parent
     while not anc.exists():
         anc = anc.parent
@@ -187,8 +208,9 @@ def _exchange(a: Path, b: Path) -> bool:
 
 
 def _write_marker(folder: Path, program: str, files, **extra):
-    data = dict(program=program, written=time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-                files=sorted(files), **extra)
+    data = dict(
+        program=program, written=time.strftime("%Y-%m-%dT%H:%M:%S%z"), files=sorted(files), **extra
+    )
     tmp = folder / f"{MARKER}.{os.getpid()}.tmp"
     with open(tmp, "w") as f:
         json.dump(data, f, indent=1)
@@ -230,8 +252,10 @@ def _merge(tmp: Path, out: Path, program: str):
     ours = marker["files"] if marker else set()
     clash = _clashes(tmp, out, "", ours)
     if clash:
-        raise OutputFolderError(f"--out: {out / clash[0]} exists and was not written by this "
-                                f"code; nothing was moved (use another path)")
+        raise OutputFolderError(
+            f"--out: {out / clash[0]} exists and was not written by this "
+            f"code; nothing was moved (use another path)"
+        )
     new = tree(tmp)
     _move_in(tmp, out)
     for rel in sorted(ours - new, key=lambda q: -q.count("/")):  # deepest first
@@ -350,8 +374,11 @@ def atomic_output_dir(out, comm=None, force=False, program=None):
                 result = ("ok",)
             except (OSError, OutputFolderError) as e:
                 shutil.rmtree(tmp, ignore_errors=True)
-                msg = str(e) if isinstance(e, OutputFolderError) else \
-                    f"--out: cannot move the results to {path}: {e.strerror or e}"
+                msg = (
+                    str(e)
+                    if isinstance(e, OutputFolderError)
+                    else f"--out: cannot move the results to {path}: {e.strerror or e}"
+                )
                 result = ("error", msg)
     result = comm.bcast(result, root=0)
     if result[0] != "ok":

@@ -8,8 +8,9 @@ load parameter runs lam: 0 -> 1 within the stage, so Newton's step cut-back work
 the friction history is committed step by step. Each stage prints one line with the load
 reached (rank 0, through problem.log) and returns a :class:`StageRecord` for metrics.json.
 
-    ramp(problem, top_y, -0.01, steps=4)                      # displacement ramp
-    reach_force(problem, top_y, "block_bottom", 1, 430.0, first_guess=-0.1)
+    ramp(problem, top_y, -0.01, steps=4)                    # a displacement ramp
+    ramp(problem, [top_y, side], [-0.02, 1.0])              # and a traction's load factor
+    reach_force(problem, top_y, "block_bottom", 1, 430.0, first_guess=-0.1)  # P = 430
     friction_on(problem, 0.3)
     reach_force(problem, top_x, "cylinder_top", 0, 64.5, first_guess=5e-5, monotone=True)
 """
@@ -96,8 +97,8 @@ def _move(problem, moves, steps, label):
     for load in _loads(problem):
         start = current_value(problem, load)
         target = moving.get(id(load), start)
-        setattr(load, _attr(load), Path(start, np.asarray(target, float) if np.ndim(target) else
-                                        float(target)))
+        target = np.asarray(target, float) if np.ndim(target) else float(target)
+        setattr(load, _attr(load), Path(start, target))
     n0 = len(problem.steps)
     problem.lam = 0.0
     problem.solve(int(steps), label=label)
@@ -123,13 +124,14 @@ def ramp(problem, bc, target, steps=1, label="ramp", boundary=None, names=None):
     moves = _as_moves(bc, target)
     names = [describe(ld) for ld, _ in moves] if names is None else list(names)
     if boundary is None:
-        named = [ld.boundary for ld, _ in moves if _attr(ld) == "value"
-                 and isinstance(ld.boundary, str)]
+        named = [
+            ld.boundary for ld, _ in moves if _attr(ld) == "value" and isinstance(ld.boundary, str)
+        ]
         boundary = named[0] if named else None
     nsteps, its = _move(problem, moves, steps, label)
     now = [current_value(problem, ld) for ld, _ in moves]
-    rec = StageRecord("ramp", label, nsteps, its, boundary=boundary,
-                      values={n: _record(v) for n, v in zip(names, now)})
+    values = {n: _record(v) for n, v in zip(names, now)}
+    rec = StageRecord("ramp", label, nsteps, its, values=values, boundary=boundary)
     reached = ", ".join(f"{n} = {_fmt(v)}" for n, v in zip(names, now))
     if boundary is not None:
         rec.force = [float(f) for f in problem.reaction(boundary)]
@@ -138,8 +140,20 @@ def ramp(problem, bc, target, steps=1, label="ramp", boundary=None, names=None):
     return rec
 
 
-def reach_force(problem, bc, boundary, component, target, first_guess, tol=1e-3, max_iter=12,
-                monotone=False, steps=1, label="force", name=None):
+def reach_force(
+    problem,
+    bc,
+    boundary,
+    component,
+    target,
+    first_guess,
+    tol=1e-3,
+    max_iter=12,
+    monotone=False,
+    steps=1,
+    label="force",
+    name=None,
+):
     """Force control: secant iterations on the value of the Dirichlet condition `bc` until the
     reaction component `component` at `boundary` is within tol |target| of `target` (name:
     the condition's name in progress lines and the record, default `describe`).
@@ -164,24 +178,33 @@ def reach_force(problem, bc, boundary, component, target, first_guess, tol=1e-3,
         history.append((value, float(force[component])))
         (v0, f0), (v1, f1) = history[-2], history[-1]
         if abs(f1 - target) <= tol * abs(target):
-            rec = StageRecord("force", label, nsteps, its, {name: float(v1)}, boundary,
-                              [float(f) for f in force], target, k + 1)
-            problem.log(f"{label}: reaction {'xyz'[component]} on {boundary} = {f1:.6g} "
-                        f"(target {target:.6g}) at {name} = {v1:.6g} after {k + 1} secant steps "
-                        f"({nsteps} load steps, {its} Newton iterations)")
+            rec = StageRecord("force", label, nsteps, its, values={name: float(v1)})
+            rec.boundary, rec.force = boundary, [float(f) for f in force]
+            rec.target, rec.secant_iterations = target, k + 1
+            problem.log(
+                f"{label}: reaction {'xyz'[component]} on {boundary} = {f1:.6g} "
+                f"(target {target:.6g}) at {name} = {v1:.6g} after {k + 1} secant steps "
+                f"({nsteps} load steps, {its} Newton iterations)"
+            )
             return rec
         if f1 == f0:
-            raise ContactSolverError(f"{label}: the reaction on {boundary} did not change between "
-                                     f"{name} = {v0:.6g} and {v1:.6g} (no contact?)")
+            raise ContactSolverError(
+                f"{label}: the reaction on {boundary} did not change between "
+                f"{name} = {v0:.6g} and {v1:.6g} (no contact?)"
+            )
         aim = target
         if monotone:  # the near end of the band, so that a small overshoot stays inside it
             aim = target - 0.5 * tol * abs(target) * np.sign(target - f1)
         value = v1 + (aim - f1) * (v1 - v0) / (f1 - f0)
         if monotone and (value - v1) * (v1 - v0) < 0:
-            raise ContactSolverError(f"{label}: monotonic loading would reverse at {name} = "
-                                     f"{v1:.6g} (reaction {f1:.6g}, target {target:.6g})")
-    raise ContactSolverError(f"{label}: reaction {'xyz'[component]} on {boundary} = {f1:.6g} did "
-                             f"not reach {target:.6g} (tol {tol:g}) in {max_iter} secant steps")
+            raise ContactSolverError(
+                f"{label}: monotonic loading would reverse at {name} = "
+                f"{v1:.6g} (reaction {f1:.6g}, target {target:.6g})"
+            )
+    raise ContactSolverError(
+        f"{label}: reaction {'xyz'[component]} on {boundary} = {f1:.6g} did "
+        f"not reach {target:.6g} (tol {tol:g}) in {max_iter} secant steps"
+    )
 
 
 def friction_on(problem, mu, label="friction"):
@@ -189,6 +212,8 @@ def friction_on(problem, mu, label="friction"):
     tangential traction: the committed plastic slip becomes the current tangential gap."""
     old = problem.mu
     problem.set_friction(mu)
-    problem.log(f"{label}: mu = {problem.mu:g} (was {old:g})"
-                + ("; tangential traction starts from zero" if old == 0 < problem.mu else ""))
+    problem.log(
+        f"{label}: mu = {problem.mu:g} (was {old:g})"
+        + ("; tangential traction starts from zero" if old == 0 < problem.mu else "")
+    )
     return StageRecord("friction", label, values={"mu": problem.mu})

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from mpi4py import MPI
 
 from . import analytic, protocol
 from .scene_spec import FUNCTIONS, SpecError, load, make_law
@@ -74,13 +75,29 @@ def _point_marker(p):
 
 
 def _check_scene(scene, spec):
-    """Every boundary marks facets and every Dirichlet point is a mesh vertex (collective)."""
+    """Every boundary marks facets, not all outside its body (a window side that the shape
+    cuts off), and every Dirichlet point is a mesh vertex (collective)."""
+    from dolfinx.mesh import compute_midpoints
+
     comm, tdim = scene.mesh.comm, scene.mesh.topology.dim
     owned = scene.mesh.topology.index_map(tdim - 1).size_local
+    names = [b["name"] for b in spec["bodies"]]
     for i, b in enumerate(spec["boundaries"]):
-        n = np.sum(scene.facet_tags.find(scene.boundaries[b["name"]]) < owned)
-        if comm.allreduce(int(n)) == 0:
+        facets = scene.facet_tags.find(scene.boundaries[b["name"]])
+        facets = facets[facets < owned]
+        if comm.allreduce(len(facets)) == 0:
             raise SpecError(f"boundaries[{i}]", f"{b['name']!r} marks no facet of the mesh")
+        if b["body"] is not None:
+            body = scene.bodies[names.index(b["body"])]
+            mid = compute_midpoints(scene.mesh, tdim - 1, facets)[:, :2]
+            tol = 1e-6 * scene.h_contact
+            inside = bool(len(facets)) and bool(np.any(np.asarray(body.shape(mid)) <= tol))
+            if not comm.allreduce(inside, op=MPI.LOR):
+                raise SpecError(
+                    f"boundaries[{i}]",
+                    f"{b['name']!r}: every facet lies outside "
+                    f"body {b['body']!r} (a side its shape cuts off?)",
+                )
     X = scene.mesh.geometry.x
     for i, d in enumerate(spec["dirichlet"]):
         if d["point"] is not None:
@@ -98,21 +115,31 @@ def build_problem(spec, scene, timer=None, log=print):
     for d in spec["dirichlet"]:
         where = d["boundary"] if d["boundary"] is not None else _point_marker(d["point"])
         loads[d["name"]] = Dirichlet(where, comp[d["component"]], 0.0)
-    tractions = [Traction(t["boundary"], _vector(scene.mesh, t["value"]), protocol.Path(0.0, 0.0))
-                 for t in spec["tractions"]]
-    forces = [BodyForce(_vector(scene.mesh, f["value"]), tags.get(f["body"]),
-                        protocol.Path(0.0, 0.0)) for f in spec["body_forces"]]
+    tractions = [
+        Traction(t["boundary"], _vector(scene.mesh, t["value"]), protocol.Path(0.0, 0.0))
+        for t in spec["tractions"]
+    ]
+    forces = [
+        BodyForce(_vector(scene.mesh, f["value"]), tags.get(f["body"]), protocol.Path(0.0, 0.0))
+        for f in spec["body_forces"]
+    ]
     loads.update({t["name"]: ld for t, ld in zip(spec["tractions"], tractions)})
     loads.update({f["name"]: ld for f, ld in zip(spec["body_forces"], forces)})
-    s, d = spec["solver"], spec["discretization"]
+    s = spec["solver"]
+    options = "mu eps0 band grid_refine num_gauss ghost_penalty quadrature_degree cut_degree"
     problem = ContactProblem(
-        scene, {tags[b["name"]]: make_law(b["law"]) for b in spec["bodies"]}, mu=s["mu"],
-        eps0=s["eps0"], band=s["band"], degree=d.get("degree", 1),
-        dirichlet=[loads[x["name"]] for x in spec["dirichlet"]], tractions=tractions,
-        loads=forces, newton=NewtonOptions(**s["newton"]), petsc_options=s["petsc"],
-        grid_refine=s["grid_refine"], num_gauss=s["num_gauss"], timer=timer,
-        ghost_penalty=s["ghost_penalty"], quadrature_degree=s["quadrature_degree"],
-        cut_degree=s["cut_degree"], log=log)
+        scene,
+        {tags[b["name"]]: make_law(b["law"]) for b in spec["bodies"]},
+        degree=spec["discretization"].get("degree", 1),
+        timer=timer,
+        log=log,
+        dirichlet=[loads[x["name"]] for x in spec["dirichlet"]],
+        tractions=tractions,
+        loads=forces,
+        newton=NewtonOptions(**s["newton"]),
+        petsc_options=s["petsc"],
+        **{k: s[k] for k in options.split()},
+    )
     targets = {x["name"]: x["value"] for x in spec["dirichlet"]}
     targets.update({x["name"]: x["scale"] for x in spec["tractions"] + spec["body_forces"]})
     return problem, loads, targets
@@ -132,19 +159,32 @@ def run_stages(problem, spec, loads, targets):
     records = []
     for st in spec["stages"]:
         if st["kind"] == "friction":
-            records.append(protocol.friction_on(problem, st["mu"], label=st["label"]))
+            rec = protocol.friction_on(problem, st["mu"], label=st["label"])
         elif st["kind"] == "ramp":
             to = st["to"] if st["to"] is not None else targets
             names = list(to)
-            records.append(protocol.ramp(
-                problem, [loads[n] for n in names],
-                [_target(problem, loads[n], to[n]) for n in names], st["steps"], st["label"],
-                boundary=spec["outputs"]["reaction"] if st["to"] is None else None, names=names))
+            values = [_target(problem, loads[n], to[n]) for n in names]
+            boundary = spec["outputs"]["reaction"] if st["to"] is None else None
+            rec = protocol.ramp(
+                problem,
+                [loads[n] for n in names],
+                values,
+                st["steps"],
+                st["label"],
+                boundary=boundary,
+                names=names,
+            )
         else:
-            records.append(protocol.reach_force(
-                problem, loads[st["dirichlet"]], st["boundary"], "xyz".index(st["component"]),
-                st["target"], st["first_guess"], st["tol"], st["max_iter"], st["monotone"],
-                st["steps"], st["label"], name=st["dirichlet"]))
+            keys = ("boundary", "target", "first_guess", "tol", "max_iter", "monotone", "steps")
+            rec = protocol.reach_force(
+                problem,
+                loads[st["dirichlet"]],
+                component="xyz".index(st["component"]),
+                label=st["label"],
+                name=st["dirichlet"],
+                **{k: st[k] for k in keys},
+            )
+        records.append(rec)
     return records
 
 
@@ -154,16 +194,19 @@ def contact_results(pts, mu):
     ends are along x (zone_ends): half-widths suit interfaces that run along x."""
     from .solver import zone_ends
 
-    x, p, q, w, gap, slip, state = (pts[k] for k in ("x", "p_n", "p_t", "w", "gap_n", "slip",
-                                                       "state"))
+    x, p, q, w, gap, slip, state = (
+        pts[k] for k in ("x", "p_n", "p_t", "w", "gap_n", "slip", "state")
+    )
     active = state != 0
-    res = {"num_points": {n: int(np.sum(state == k)) for k, n in enumerate(("open", "stick",
-                                                                              "slip"))},
-           "contact_force": float(np.sum(w * p)), "tangential_force": float(np.sum(w * q)),
-           "contact_length": float(np.sum(w[active])),
-           "peak_pressure": float(p.max()) if p.size else None,
-           "shear_max": float(np.abs(q).max()) if q.size else None,
-           "max_penetration": float(max(0.0, -gap[active].min())) if active.any() else None}
+    res = {
+        "num_points": {n: int(np.sum(state == k)) for k, n in enumerate(("open", "stick", "slip"))},
+        "contact_force": float(np.sum(w * p)),
+        "tangential_force": float(np.sum(w * q)),
+        "contact_length": float(np.sum(w[active])),
+        "peak_pressure": float(p.max()) if p.size else None,
+        "shear_max": float(np.abs(q).max()) if q.size else None,
+        "max_penetration": float(max(0.0, -gap[active].min())) if active.any() else None,
+    }
     xl, xr = zone_ends(x, active, gap)
     res["contact_half_width"] = None if xl is None else float(0.5 * (xr - xl))
     res["contact_centre"] = None if xl is None else float(0.5 * (xr + xl))
@@ -186,6 +229,8 @@ def _hertz(ref, spec, pts, reactions, problem):
     E_star = analytic.effective_modulus(l1["E"], l1["nu"], l2["E"], l2["nu"])
     nf = ref["normal_force"]
     P = abs(reactions[nf["boundary"]]["xyz".index(nf["component"])])
+    if P == 0:  # no load reached the contact: nothing to compare
+        return {}, {}, {}
     a, p0 = analytic.hertz_line(P, ref["R"], E_star)
     x, w = pts["x"], pts["w"]
     res = {"pressure_rel_l2_error": _rel_l2(w, pts["p_n"], analytic.hertz_pressure(x, a, p0))}
@@ -193,17 +238,21 @@ def _hertz(ref, spec, pts, reactions, problem):
     tf, mu = ref["tangential_force"], problem.mu
     if tf is not None and mu > 0:
         Q = abs(reactions[tf["boundary"]]["xyz".index(tf["component"])])
-        c = float(analytic.mindlin_stick_half_width(a, Q, mu, P))
-        qa = analytic.mindlin_shear(x, a, c, p0, mu)
-        res.update(tangential_ratio=float(Q / (mu * P)),
-                   traction_rel_l2_error=_rel_l2(w, np.abs(pts["p_t"]), qa))
-        an.update(stick_half_width=c, tangential_force=float(Q))
+        res["tangential_ratio"] = float(Q / (mu * P))
+        an["tangential_force"] = float(Q)
+        if Q < mu * P:  # partial slip: Cattaneo-Mindlin
+            c = float(analytic.mindlin_stick_half_width(a, Q, mu, P))
+            qa = analytic.mindlin_shear(x, a, c, p0, mu)
+            res["traction_rel_l2_error"] = _rel_l2(w, np.abs(pts["p_t"]), qa)
+            an["stick_half_width"] = c
     xs = np.linspace(-1.5 * a, 1.5 * a, 400)
     plot = {"Hertz p(x)": (xs, analytic.hertz_pressure(xs, a, p0))}
     if "stick_half_width" in an:
         sign = np.sign(np.sum(pts["p_t"])) or 1.0
-        plot["Cattaneo-Mindlin q(x)"] = (xs, sign * analytic.mindlin_shear(
-            xs, a, an["stick_half_width"], p0, mu))
+        plot["Cattaneo-Mindlin q(x)"] = (
+            xs,
+            sign * analytic.mindlin_shear(xs, a, an["stick_half_width"], p0, mu),
+        )
     return res, an, plot
 
 
@@ -213,14 +262,18 @@ def _patch(ref, spec, pts, reactions, problem):
     Ep, d, H = law["E"] / (1 - law["nu"] ** 2), ref["displacement"], ref["height"]
     exact = float(analytic.patch_pressure(law["E"], law["nu"], d / H))
     penalised = float(Ep * d / (H + Ep * problem.eps_n))
+    an = {"pressure": exact, "pressure_penalised": penalised}
     p, w = pts["p_n"], pts["w"]
-    res = {"pressure_mean": float(np.sum(w * p) / np.sum(w)),
-           "pressure_max_rel_deviation": float(np.max(np.abs(p - penalised)) / penalised),
-           "pressure_rel_error_vs_exact": float(np.max(np.abs(p - exact)) / exact),
-           "pressure_rel_l2_error": _rel_l2(w, p, np.full_like(p, penalised))}
+    if not p.size:  # no contact point: nothing to compare (the checks fail with a reason)
+        return {}, an, {}
+    res = {
+        "pressure_mean": float(np.sum(w * p) / np.sum(w)),
+        "pressure_max_rel_deviation": float(np.max(np.abs(p - penalised)) / penalised),
+        "pressure_rel_error_vs_exact": float(np.max(np.abs(p - exact)) / exact),
+        "pressure_rel_l2_error": _rel_l2(w, p, np.full_like(p, penalised)),
+    }
     xs = np.array([pts["x"].min(), pts["x"].max()])
-    plot = {"exact": (xs, [exact] * 2), "penalised": (xs, [penalised] * 2)}
-    return res, {"pressure": exact, "pressure_penalised": penalised}, plot
+    return res, an, {"exact": (xs, [exact] * 2), "penalised": (xs, [penalised] * 2)}
 
 
 REFERENCES = {"hertz": _hertz, "patch": _patch}
@@ -242,12 +295,19 @@ def evaluate_checks(metrics, checks):
     """Records {label, quantity, value, criterion, passed, reason} of the checks."""
     out = []
     for c in checks:
-        rec = {"label": c["label"], "quantity": c["quantity"], "value": None, "passed": False,
-               "reason": ""}
+        rec = {
+            "label": c["label"],
+            "quantity": c["quantity"],
+            "value": None,
+            "passed": False,
+            "reason": "",
+        }
         try:
             value = lookup(metrics, c["quantity"])
-            refs = {k: lookup(metrics, c[k]) if isinstance(c[k], str) else c[k]
-                    for k in ("close_to", "below", "above")}
+            refs = {
+                k: lookup(metrics, c[k]) if isinstance(c[k], str) else c[k]
+                for k in ("close_to", "below", "above")
+            }
         except KeyError as e:
             rec.update(criterion="", reason=f"{e.args[0]} is not in metrics.json")
             out.append(rec)
@@ -256,8 +316,11 @@ def evaluate_checks(metrics, checks):
         if refs["close_to"] is not None:
             tol = max(c["atol"] or 0.0, (c["rtol"] or 0.0) * abs(refs["close_to"] or 0.0))
             parts.append(f"close to {refs['close_to']:.6g} within {tol:.3g}")
-            ok &= value is not None and refs["close_to"] is not None and \
-                abs(value - refs["close_to"]) <= tol
+            ok &= (
+                value is not None
+                and refs["close_to"] is not None
+                and abs(value - refs["close_to"]) <= tol
+            )
         if refs["below"] is not None:
             parts.append(f"<= {refs['below']:.6g}")
             ok &= value is not None and value <= refs["below"]
@@ -281,14 +344,21 @@ def _reaction_boundaries(spec):
     return [n for n in dict.fromkeys(names) if n is not None]
 
 
-def run(source, out=None, *, overrides=(), comm=None, force=False, write=True, log=print,
-        build_scene=None) -> RunResult:
+def run(
+    source,
+    out=None,
+    *,
+    overrides=(),
+    comm=None,
+    force=False,
+    write=True,
+    log=print,
+    build_scene=None,
+) -> RunResult:
     """Run a description (a TOML path or a dict, see scene_spec). out: the result folder
     (default results/<name>); write=False computes without writing. build_scene(comm, spec)
     -> Scene replaces meshes.from_spec.build_scene. Raises SpecError (bad description),
     OutputFolderError (refused --out) before computing, ContactSolverError (solver failure)."""
-    from mpi4py import MPI
-
     from .folders import atomic_output_dir, check_output_path
     from .output import gather_points, plot_tractions, write_fields, write_tractions
     from .results import PhaseTimer, new_metrics, write_metrics
@@ -303,8 +373,10 @@ def run(source, out=None, *, overrides=(), comm=None, force=False, write=True, l
         try:
             from meshes.from_spec import build_scene
         except ImportError as e:
-            raise ImportError("the scene builders (the `meshes` package of this repository) "
-                              "must be importable: run from the repository root") from e
+            raise ImportError(
+                "the scene builders (the `meshes` package of this repository) "
+                "must be importable: run from the repository root"
+            ) from e
     kind = spec["discretization"]["kind"]
     metrics = new_metrics(spec["name"], DISCRETIZATION_NAMES[kind], spec)
     timer = PhaseTimer(metrics)
@@ -316,9 +388,11 @@ def run(source, out=None, *, overrides=(), comm=None, force=False, write=True, l
 
     reactions = {b: [float(f) for f in problem.reaction(b)] for b in _reaction_boundaries(spec)}
     pts = gather_points(problem)
-    metrics["mesh"].update(h_contact=scene.h_contact, num_dofs=problem.num_dofs,
-                           num_cells=scene.mesh.topology.index_map(scene.mesh.topology.dim)
-                           .size_global)
+    metrics["mesh"].update(
+        h_contact=scene.h_contact,
+        num_dofs=problem.num_dofs,
+        num_cells=scene.mesh.topology.index_map(scene.mesh.topology.dim).size_global,
+    )
     metrics["solver"] = solver_metrics(problem)
     metrics["stages"] = [r.as_dict() for r in records]
     plot = {}
@@ -328,19 +402,23 @@ def run(source, out=None, *, overrides=(), comm=None, force=False, write=True, l
         res["reaction"] = reactions.get(spec["outputs"]["reaction"])
         res["reactions"] = reactions
         if spec["analytic"] is not None:
-            r, an, plot = REFERENCES[spec["analytic"]["type"]](spec["analytic"], spec, pts,
-                                                                reactions, problem)
+            r, an, plot = REFERENCES[spec["analytic"]["type"]](
+                spec["analytic"], spec, pts, reactions, problem
+            )
             res.update(r)
             metrics["analytic"].update(an)
         metrics["checks"] = evaluate_checks(metrics, spec["checks"])
         metrics["checks_passed"] = all(c["passed"] for c in metrics["checks"])
         for c in metrics["checks"]:
-            log(f"check {c['label']}: {'ok' if c['passed'] else 'FAILED'} "
-                f"({c['reason'] or c['criterion']})")
+            log(
+                f"check {c['label']}: {'ok' if c['passed'] else 'FAILED'} "
+                f"({c['reason'] or c['criterion']})"
+            )
     timer.stop()
     metrics = comm.bcast(metrics if comm.rank == 0 else None, root=0)
-    failures = [f"check {c['label']!r} failed: {c['reason']}" for c in metrics["checks"]
-                if not c["passed"]]
+    failures = [
+        f"check {c['label']!r} failed: {c['reason']}" for c in metrics["checks"] if not c["passed"]
+    ]
     result = RunResult(metrics, not failures, failures, None, problem)
     if not write:
         return result
@@ -352,8 +430,12 @@ def run(source, out=None, *, overrides=(), comm=None, force=False, write=True, l
             if o["tractions"]:
                 write_tractions(folder, pts)
             if o["plot"] and len(pts["x"]):
-                plot_tractions(Path(folder) / "tractions.png", pts, plot,
-                               title=f"{spec['name']}, h = {scene.h_contact:.3g}")
+                plot_tractions(
+                    Path(folder) / "tractions.png",
+                    pts,
+                    plot,
+                    title=f"{spec['name']}, h = {scene.h_contact:.3g}",
+                )
             write_metrics(folder, metrics)
     result.folder = out.resolve()
     return result

@@ -8,12 +8,14 @@ records as its parameters. Keys (defaults in brackets; "box" is [[x_min, y_min],
 an "expression" is a number or a string in x, y, z with + - * / **, pi and sqrt, sin, cos,
 tan, exp, log, abs):
 
-  name ["scene"; the file's stem], description [""]
+  name ["scene"; the file's stem], description [""], extends [none] (a description this one
+      changes: its tables merged key by key, anything else replaced)
   [discretization]  kind = "cut" | "fitted", h (mesh size at the contact),
       cut:    extent (box of the background grid), fine [none: uniform grid] (box where the
               spacing is h, widened to the multiples of h), growth [1.2], h_far [no cap]
       fitted: cell ["triangle" | "quadrilateral"], degree [1], fine [the contact box], h_far
-              [8 h], slope [0.25] (gmsh size growth per unit distance from `fine`)
+              [8 h], slope [0.25] (gmsh size growth per unit distance from `fine`),
+              structured [false] (boxes without a window: transfinite grids of about h)
       both:   contact_box [the pairs' overlaps] (cells owned by MPI rank 0)
   [solver]  eps0 [1.0], band [2 h], mu [0.0], ghost_penalty [0.01], grid_refine [4],
       num_gauss [2], steps [1], quadrature_degree, cut_degree [4], petsc {KEY = VALUE},
@@ -54,13 +56,15 @@ from pathlib import Path
 
 __all__ = ["SpecError", "load", "validate", "apply_overrides", "parse_expression", "SIDES"]
 
-SIDES = ("left", "right", "bottom", "top", "back", "front")
+SIDES = ("left", "right", "bottom", "top")
 COMPONENTS = {"x": 0, "y": 1, "z": 2}
 LAW_PARAMETERS = {  # type -> (required, optional with defaults); laws.LAWS builds them
     "linear": (("E", "nu"), {}),
     "orthotropic": (("E1", "E2", "E3", "nu12", "nu13", "nu23", "G12"), {"angle": 0.0}),
     "neo-hookean": (("E", "nu"), {}),
 }
+BOUNDS = {"nu": dict(lo=-1, hi=0.5, lo_open=True, hi_open=True)}  # others: moduli > 0
+BOUNDS.update({k: dict(lo=0, lo_open=True) for k in ("E", "E1", "E2", "E3", "G12")})
 SHAPES = {  # type -> (required, optional with defaults)
     "circle": (("centre", "radius"), {}),
     "ellipse": (("centre", "axes"), {"angle": 0.0}),
@@ -119,13 +123,28 @@ def parse_expression(text, key, names=("x", "y", "z")):
     allowed = set(names) | set(FUNCTIONS) | {"pi"}
     for node in ast.walk(tree):
         if isinstance(node, ast.Name) and node.id not in allowed:
-            raise SpecError(key, f"unknown name {node.id!r} in {text!r} (allowed: "
-                                 f"{', '.join(sorted(allowed))})")
-        if isinstance(node, ast.Call) and not (isinstance(node.func, ast.Name)
-                                               and node.func.id in FUNCTIONS):
+            raise SpecError(
+                key,
+                f"unknown name {node.id!r} in {text!r} (allowed: {', '.join(sorted(allowed))})",
+            )
+        if isinstance(node, ast.Call) and not (
+            isinstance(node.func, ast.Name) and node.func.id in FUNCTIONS
+        ):
             raise SpecError(key, f"only {', '.join(FUNCTIONS)} may be called in {text!r}")
-        if not isinstance(node, (ast.Expression, ast.BinOp, ast.UnaryOp, ast.Constant, ast.Name,
-                                 ast.Call, ast.Load, ast.operator, ast.unaryop)):
+        if not isinstance(
+            node,
+            (
+                ast.Expression,
+                ast.BinOp,
+                ast.UnaryOp,
+                ast.Constant,
+                ast.Name,
+                ast.Call,
+                ast.Load,
+                ast.operator,
+                ast.unaryop,
+            ),
+        ):
             raise SpecError(key, f"unsupported syntax in {text!r}")
         if isinstance(node, ast.Constant) and not isinstance(node.value, (int, float)):
             raise SpecError(key, f"only numbers are allowed in {text!r}")
@@ -169,8 +188,9 @@ class _Table:
         if not isinstance(v, str):
             raise SpecError(self.path(k), f"must be a string, got {v!r}")
         if choices is not None and v not in choices:
-            raise SpecError(self.path(k), f"must be one of {', '.join(map(repr, choices))}, "
-                                          f"got {v!r}")
+            raise SpecError(
+                self.path(k), f"must be one of {', '.join(map(repr, choices))}, got {v!r}"
+            )
         return v
 
     def boolean(self, k, default=_REQUIRED):
@@ -197,11 +217,11 @@ class _Table:
             raise SpecError(self.path(k), f"must be an array of tables ([[{k}]]), got {v!r}")
         return [_Table(item, f"{self.path(k)}[{i}]") for i, item in enumerate(v)]
 
-    def done(self, allowed_elsewhere=()):
-        unknown = set(self.data) - self.used - set(allowed_elsewhere)
+    def done(self):
+        unknown = set(self.data) - self.used
         if unknown:
             k = sorted(unknown)[0]
-            known = ", ".join(sorted(self.used | set(allowed_elsewhere)))
+            known = ", ".join(sorted(self.used))
             raise SpecError(self.path(k), f"unknown key (expected one of: {known})")
 
 
@@ -237,13 +257,14 @@ def _discretization(t):
             raise SpecError(t.path("cell"), "the cut grid is made of quadrilaterals")
         if t.integer("degree", 1) != 1:
             raise SpecError(t.path("degree"), "the cut discretization supports degree 1 only")
-        other = ("slope",)
+        other = ("slope", "structured")
     else:
         d["cell"] = t.string("cell", "triangle", choices=("triangle", "quadrilateral"))
         d["degree"] = t.integer("degree", 1, lo=1, hi=2)
         d["fine"] = t.box("fine", None)
         d["h_far"] = t.number("h_far", 8 * d["h"], lo=0, lo_open=True)
         d["slope"] = t.number("slope", 0.25, lo=0, lo_open=True)
+        d["structured"] = t.boolean("structured", False)
         other = ("extent", "growth")
     d["contact_box"] = t.box("contact_box", None)
     for k in other:
@@ -254,15 +275,17 @@ def _discretization(t):
 
 
 def _solver(t):
-    s = dict(eps0=t.number("eps0", 1.0, lo=0, lo_open=True),
-             band=t.number("band", None, lo=0, lo_open=True),
-             mu=t.number("mu", 0.0, lo=0),
-             ghost_penalty=t.number("ghost_penalty", 0.01, lo=0),
-             grid_refine=t.integer("grid_refine", 4, lo=1, hi=16),
-             num_gauss=t.integer("num_gauss", 2, lo=1, hi=5),
-             steps=t.integer("steps", 1, lo=1, hi=1000),
-             quadrature_degree=t.integer("quadrature_degree", None, lo=1, hi=20),
-             cut_degree=t.integer("cut_degree", 4, lo=1, hi=20))
+    s = dict(
+        eps0=t.number("eps0", 1.0, lo=0, lo_open=True),
+        band=t.number("band", None, lo=0, lo_open=True),
+        mu=t.number("mu", 0.0, lo=0),
+        ghost_penalty=t.number("ghost_penalty", 0.01, lo=0),
+        grid_refine=t.integer("grid_refine", 4, lo=1, hi=16),
+        num_gauss=t.integer("num_gauss", 2, lo=1, hi=5),
+        steps=t.integer("steps", 1, lo=1, hi=1000),
+        quadrature_degree=t.integer("quadrature_degree", None, lo=1, hi=20),
+        cut_degree=t.integer("cut_degree", 4, lo=1, hi=20),
+    )
     petsc = t.table("petsc", {})
     s["petsc"] = {}
     for k, v in petsc.data.items():
@@ -270,10 +293,13 @@ def _solver(t):
             raise SpecError(petsc.path(k), f"must be a string or a number, got {v!r}")
         s["petsc"][k] = str(v).lower() if isinstance(v, bool) else str(v)
     newton = t.table("newton", {})
-    s["newton"] = {k: newton.number(k, None, lo=0, lo_open=True)
-                   for k in ("rtol", "atol", "stol")}
-    s["newton"].update({k: newton.integer(k, None, lo=lo) for k, lo in
-                        (("max_iterations", 1), ("max_cutbacks", 0))})
+    s["newton"] = {k: newton.number(k, None, lo=0, lo_open=True) for k in ("rtol", "atol", "stol")}
+    s["newton"].update(
+        {
+            k: newton.integer(k, None, lo=lo)
+            for k, lo in (("max_iterations", 1), ("max_cutbacks", 0))
+        }
+    )
     s["newton"] = {k: v for k, v in s["newton"].items() if v is not None}
     newton.done()
     t.done()
@@ -290,8 +316,9 @@ def _shape(t, base_dir):
         axes = t.raw("axes")
         if not isinstance(axes, list) or len(axes) != 2:
             raise SpecError(t.path("axes"), f"must be [a, b], got {axes!r}")
-        s["axes"] = [_number(a, f"{t.path('axes')}[{i}]", lo=0, lo_open=True)
-                     for i, a in enumerate(axes)]
+        s["axes"] = [
+            _number(a, f"{t.path('axes')}[{i}]", lo=0, lo_open=True) for i, a in enumerate(axes)
+        ]
     elif kind == "box":
         s["min"], s["max"] = _box([t.raw("min"), t.raw("max")], t.key)
     elif kind == "polygon":
@@ -307,8 +334,9 @@ def _shape(t, base_dir):
                 raise SpecError(t.path("file"), f"cannot read points from {path}: {e}") from None
             s["file"] = file
         if not isinstance(pts, list) or len(pts) < 3:
-            raise SpecError(t.path("points" if file is None else "file"),
-                            "a polygon needs at least 3 points")
+            raise SpecError(
+                t.path("points" if file is None else "file"), "a polygon needs at least 3 points"
+            )
         s["points"] = [_point(p, f"{t.path('points')}[{i}]") for i, p in enumerate(pts)]
     else:
         s.update(point=t.point("point"), normal=t.point("normal"))
@@ -332,8 +360,11 @@ def make_law(law):
 def _law(t):
     kind = t.string("type", choices=tuple(LAW_PARAMETERS))
     required, optional = LAW_PARAMETERS[kind]
-    law = {"type": kind, **{k: t.number(k) for k in required},
-           **{k: t.number(k, v) for k, v in optional.items()}}
+    law = {
+        "type": kind,
+        **{k: t.number(k, **BOUNDS.get(k, {})) for k in required},
+        **{k: t.number(k, v) for k, v in optional.items()},
+    }
     t.done()
     try:
         make_law(law)
@@ -353,8 +384,9 @@ def _stage(t, i, loads, dirichlet, boundaries, default_steps):
                 if k not in loads:
                     raise SpecError(to.path(k), f"unknown load (known: {', '.join(loads)})")
                 if loads[k] != "dirichlet" and isinstance(v, str):
-                    raise SpecError(to.path(k), "a traction or body force target is a number "
-                                                "(its scale)")
+                    raise SpecError(
+                        to.path(k), "a traction or body force target is a number (its scale)"
+                    )
                 st["to"][k] = parse_expression(v, to.path(k))
         else:
             st["to"] = None
@@ -362,22 +394,30 @@ def _stage(t, i, loads, dirichlet, boundaries, default_steps):
     elif kind == "force":
         name = _name(t, "dirichlet", list(dirichlet), "Dirichlet condition")
         bc = dirichlet[name]
-        st.update(dirichlet=name, boundary=_name(t, "boundary", boundaries, "boundary",
-                                                 bc.get("boundary")))
+        st.update(
+            dirichlet=name,
+            boundary=_name(t, "boundary", boundaries, "boundary", bc.get("boundary")),
+        )
         if st["boundary"] is None:
             raise SpecError(t.path("boundary"), "missing (the condition is on a point)")
         st["component"] = _component(t, "component", bc["component"])
         if st["component"] == "all" or bc["component"] not in ("all", st["component"]):
-            raise SpecError(t.path("component"), f"must be the component the condition "
-                                                 f"{name!r} prescribes")
+            raise SpecError(
+                t.path("component"), f"must be the component the condition {name!r} prescribes"
+            )
         if isinstance(bc["value"], str):
-            raise SpecError(t.path("dirichlet"), f"{name!r} has a per-dof value: force control "
-                                                 "moves one value")
-        st.update(target=t.number("target"), first_guess=t.number("first_guess"),
-                  tol=t.number("tol", 1e-3, lo=0, lo_open=True),
-                  max_iter=t.integer("max_iter", 12, lo=1, hi=1000),
-                  monotone=t.boolean("monotone", False),
-                  steps=t.integer("steps", 1, lo=1, hi=1000))
+            raise SpecError(
+                t.path("dirichlet"),
+                f"{name!r} has a per-dof value: force control moves one value",
+            )
+        st.update(
+            target=t.number("target"),
+            first_guess=t.number("first_guess"),
+            tol=t.number("tol", 1e-3, lo=0, lo_open=True),
+            max_iter=t.integer("max_iter", 12, lo=1, hi=1000),
+            monotone=t.boolean("monotone", False),
+            steps=t.integer("steps", 1, lo=1, hi=1000),
+        )
         if st["target"] == 0:
             raise SpecError(t.path("target"), "must not be 0 (the tolerance is relative)")
     else:
@@ -390,8 +430,10 @@ def _force_ref(t, k, boundaries, default=_REQUIRED):
     r = t.table(k, default)
     if r is None:
         return None
-    out = {"boundary": _name(r, "boundary", boundaries, "boundary"),
-           "component": _component(r, "component", _REQUIRED)}
+    out = {
+        "boundary": _name(r, "boundary", boundaries, "boundary"),
+        "component": _component(r, "component", _REQUIRED),
+    }
     if out["component"] == "all":
         raise SpecError(r.path("component"), "must be 'x', 'y' or 'z'")
     r.done()
@@ -410,9 +452,11 @@ def _analytic(t, bodies, pairs, boundaries):
         a["normal_force"] = _force_ref(t, "normal_force", boundaries)
         a["tangential_force"] = _force_ref(t, "tangential_force", boundaries, None)
     else:
-        a.update(displacement=t.number("displacement", lo=0, lo_open=True),
-                 height=t.number("height", lo=0, lo_open=True),
-                 body=_name(t, "body", list(bodies), "body", next(iter(bodies))))
+        a.update(
+            displacement=t.number("displacement", lo=0, lo_open=True),
+            height=t.number("height", lo=0, lo_open=True),
+            body=_name(t, "body", list(bodies), "body", next(iter(bodies))),
+        )
     for name in a.get("bodies", [a.get("body")]):
         if bodies[name]["law"]["type"] != "linear":
             raise SpecError(t.path("type"), f"the {kind} reference needs linear laws ({name!r})")
@@ -431,8 +475,10 @@ def _path_or_number(t, k):
 def _metric_path(v, key):
     root = v.split(".")[0].split("[")[0]
     if not isinstance(v, str) or root not in CHECK_ROOTS:
-        raise SpecError(key, f"must be a metrics path starting with one of "
-                             f"{', '.join(CHECK_ROOTS)}, got {v!r}")
+        raise SpecError(
+            key,
+            f"must be a metrics path starting with one of {', '.join(CHECK_ROOTS)}, got {v!r}",
+        )
     return v
 
 
@@ -456,8 +502,7 @@ def validate(data, base_dir=None, default_name="scene"):
     """Check a description (a dict, as read from TOML) and return a new dict with every
     default filled in. Raises SpecError naming the first bad key."""
     top = _Table(copy.deepcopy(data), "")
-    spec = {"name": top.string("name", default_name),
-            "description": top.string("description", "")}
+    spec = {"name": top.string("name", default_name), "description": top.string("description", "")}
     spec["discretization"] = _discretization(top.table("discretization"))
     spec["solver"] = _solver(top.table("solver", {}))
 
@@ -466,8 +511,12 @@ def validate(data, base_dir=None, default_name="scene"):
         name = b.string("name")
         if name in bodies:
             raise SpecError(b.path("name"), f"duplicate body name {name!r}")
-        bodies[name] = {"name": name, "shape": _shape(b.table("shape"), base_dir),
-                        "law": _law(b.table("law")), "window": b.box("window", None)}
+        bodies[name] = {
+            "name": name,
+            "shape": _shape(b.table("shape"), base_dir),
+            "law": _law(b.table("law")),
+            "window": b.box("window", None),
+        }
         if bodies[name]["shape"]["type"] == "half_plane" and bodies[name]["window"] is None:
             raise SpecError(b.path("window"), "a half_plane body needs a window")
         b.done()
@@ -479,13 +528,17 @@ def validate(data, base_dir=None, default_name="scene"):
     pairs = []
     for p in top.tables("pairs"):
         v = p.raw("bodies")
-        if (not isinstance(v, list) or len(v) != 2 or v[0] == v[1]
-                or any(n not in bodies for n in v)):
+        if (
+            not isinstance(v, list)
+            or len(v) != 2
+            or v[0] == v[1]
+            or any(n not in bodies for n in v)
+        ):
             raise SpecError(p.path("bodies"), f"must be two different body names, got {v!r}")
         pairs.append(list(v))
         p.done()
     if not top.has("pairs"):
-        pairs = [[a, b] for i, a in enumerate(names) for b in names[i + 1:]]
+        pairs = [[a, b] for i, a in enumerate(names) for b in names[i + 1 :]]
     spec["pairs"] = pairs
 
     boundaries = {}
@@ -500,15 +553,19 @@ def validate(data, base_dir=None, default_name="scene"):
             sides = b.raw("side")
             sides = [sides] if isinstance(sides, str) else sides
             if not isinstance(sides, list) or not sides or any(s not in SIDES for s in sides):
-                raise SpecError(b.path("side"), f"must be one or more of {', '.join(SIDES)}, "
-                                                f"got {b.raw('side')!r}")
+                raise SpecError(
+                    b.path("side"),
+                    f"must be one or more of {', '.join(SIDES)}, got {b.raw('side')!r}",
+                )
             if bd["body"] is None:
                 raise SpecError(b.path("body"), "missing (side is a side of a body)")
             bd["side"] = sides
         else:
             box = b.table("box")
-            bd["box"] = {k: box.number(k, None) for k in
-                         ("x_min", "x_max", "y_min", "y_max", "z_min", "z_max")}
+            bd["box"] = {
+                k: box.number(k, None)
+                for k in ("x_min", "x_max", "y_min", "y_max", "z_min", "z_max")
+            }
             box.done()
         boundaries[name] = bd
         b.done()
@@ -528,8 +585,11 @@ def validate(data, base_dir=None, default_name="scene"):
     for t in top.tables("dirichlet"):
         if t.has("boundary") == t.has("point"):
             raise SpecError(t.path("boundary"), "give exactly one of boundary and point")
-        d = {"boundary": _name(t, "boundary", bnames, "boundary", None),
-             "point": t.point("point", None), "component": _component(t, "component", "all")}
+        d = {
+            "boundary": _name(t, "boundary", bnames, "boundary", None),
+            "point": t.point("point", None),
+            "component": _component(t, "component", "all"),
+        }
         d["value"] = parse_expression(t.raw("value", 0.0), t.path("value"))
         d["name"] = t.string("name", f"{d['boundary'] or 'point'}.{d['component']}")
         dirichlet[d["name"]] = d
@@ -537,23 +597,33 @@ def validate(data, base_dir=None, default_name="scene"):
     for section, where in (("tractions", "boundary"), ("body_forces", "body")):
         spec[section] = []
         for t in top.tables(section):
-            ref = (_name(t, "boundary", bnames, "boundary") if where == "boundary"
-                   else _name(t, "body", names, "body", None))
+            ref = (
+                _name(t, "boundary", bnames, "boundary")
+                if where == "boundary"
+                else _name(t, "body", names, "body", None)
+            )
             value = t.raw("value")
             if not isinstance(value, list) or len(value) not in (2, 3):
                 raise SpecError(t.path("value"), f"must be a vector [f_x, f_y], got {value!r}")
-            e = {where: ref, "value": [parse_expression(v, f"{t.path('value')}[{i}]")
-                                       for i, v in enumerate(value)],
-                 "scale": t.number("scale", 1.0)}
+            e = {
+                where: ref,
+                "value": [
+                    parse_expression(v, f"{t.path('value')}[{i}]") for i, v in enumerate(value)
+                ],
+                "scale": t.number("scale", 1.0),
+            }
             e["name"] = t.string("name", ref if ref is not None else f"{section}-{len(loads)}")
             spec[section].append(add_load(t, e, section))
 
     stages = top.tables("stages")
-    spec["stages"] = [_stage(s, i, loads, dirichlet, bnames, spec["solver"]["steps"])
-                      for i, s in enumerate(stages, start=1)]
+    spec["stages"] = [
+        _stage(s, i, loads, dirichlet, bnames, spec["solver"]["steps"])
+        for i, s in enumerate(stages, start=1)
+    ]
     if not stages:
-        spec["stages"] = [{"kind": "ramp", "label": "load", "to": None,
-                           "steps": spec["solver"]["steps"]}]
+        spec["stages"] = [
+            {"kind": "ramp", "label": "load", "to": None, "steps": spec["solver"]["steps"]}
+        ]
 
     out = top.table("outputs", {})
     first = next((d["boundary"] for d in spec["dirichlet"] if d["boundary"]), None)
@@ -599,11 +669,18 @@ def apply_overrides(data, overrides):
     return data
 
 
-def load(source, overrides=()):
-    """A checked description from a TOML file path or a dict (see the module docstring)."""
-    if isinstance(source, dict):
-        return validate(apply_overrides(source, overrides))
-    path = Path(source)
+def _merge(base, over):
+    """`over` on top of `base`: tables merged key by key, anything else (arrays of tables
+    included) replaced."""
+    out = dict(base)
+    for k, v in over.items():
+        out[k] = _merge(base[k], v) if isinstance(v, dict) and isinstance(base.get(k), dict) else v
+    return out
+
+
+def _read(path, seen=()):
+    """A TOML file as a dict, with `extends = "other.toml"` (relative to the file) resolved."""
+    path = Path(path)
     try:
         with open(path, "rb") as f:
             data = tomllib.load(f)
@@ -611,5 +688,22 @@ def load(source, overrides=()):
         raise SpecError(str(path), f"cannot read the description ({e.strerror})") from None
     except tomllib.TOMLDecodeError as e:
         raise SpecError(str(path), f"not valid TOML ({e})") from None
-    return validate(apply_overrides(data, overrides), base_dir=path.parent,
-                    default_name=path.stem)
+    base = data.pop("extends", None)
+    if base is None:
+        return data
+    if not isinstance(base, str):
+        raise SpecError("extends", f"must be a file name, got {base!r}")
+    base = path.parent / base
+    if base.resolve() in seen:
+        raise SpecError("extends", f"{base} extends itself")
+    return _merge(_read(base, (*seen, path.resolve())), data)
+
+
+def load(source, overrides=()):
+    """A checked description from a TOML file path or a dict (see the module docstring)."""
+    if isinstance(source, dict):
+        return validate(apply_overrides(source, overrides))
+    path = Path(source)
+    return validate(
+        apply_overrides(_read(path), overrides), base_dir=path.parent, default_name=path.stem
+    )

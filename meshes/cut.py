@@ -198,18 +198,14 @@ def _body_grid(xlines, ylines, body):
     kinds = np.where(pc[active].max(axis=1) > 0, CUT, INTERIOR).astype(np.int32)
     used, cells = np.unique(quads[active], return_inverse=True)
     bbox = body.bbox
-    if bbox is None:  # vertices inside plus the zero crossings (linear) on the grid edges
-        P = phi.reshape(ny + 1, nx + 1)
-        G = pts.reshape(ny + 1, nx + 1, 2)
-        found = [pts[phi <= 0]]
-        for ax in (0, 1):  # edges along y (ax 0) and along x (ax 1)
-            sl0 = (slice(None, -1), slice(None)) if ax == 0 else (slice(None), slice(None, -1))
-            sl1 = (slice(1, None), slice(None)) if ax == 0 else (slice(None), slice(1, None))
-            pa, pb = P[sl0], P[sl1]
-            cross = (pa <= 0) != (pb <= 0)
-            t = pa[cross] / (pa[cross] - pb[cross])
-            found.append(G[sl0][cross] + t[:, None] * (G[sl1][cross] - G[sl0][cross]))
-        found = np.concatenate(found)
+    if bbox is None:  # vertices inside plus the ends of the zero contour in the cut cells
+        from dolfinx_forms import _cpp
+
+        cut = quads[active][kinds == CUT]
+        c = _cpp.cell_contours(phi[cut])  # marching squares of the cut kernels (linear crossings)
+        k, e = np.nonzero(np.isfinite(c["t"]))
+        a, b = (cut[k, np.asarray(c["edges"])[e, m]] for m in (0, 1))
+        found = np.concatenate([pts[phi <= 0], pts[a] + c["t"][k, e][:, None] * (pts[b] - pts[a])])
         bbox = np.array([found.min(axis=0), found.max(axis=0)])
     return pts[used], cells.reshape(-1, 4), kinds, np.asarray(bbox, float)
 

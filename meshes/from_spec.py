@@ -12,8 +12,9 @@ a body is shape ∩ window when it has a window.
   on its window's sides are pushed out (those sides are grid lines: no cell is cut there).
 * fitted: each body is a gmsh OpenCASCADE surface (disk, ellipse, rectangle, polygon,
   intersected with its window), meshed with size h on `fine` (default: the contact box),
-  growing with `slope` per unit distance up to h_far; quadrilaterals by recombination (meshed
-  at 2h, every cell subdivided). Bodies are separate surfaces: coincident boundaries keep
+  growing with `slope` per unit distance up to h_far (`structured`: boxes without a window are
+  transfinite grids instead); quadrilaterals by recombination (meshed at 2h, every cell
+  subdivided). Bodies are separate surfaces: coincident boundaries keep
   distinct vertices.
 Boundaries: `side` = sides of the body's window (cut) or bounding box (fitted); `box` = the
 boundary facets inside the box (of `body` if given). Boundary tags 1, 2, ... in order.
@@ -37,8 +38,9 @@ def _error(key, message):
 def _clip_halfplane(box, point, normal):
     """Bounding box of box ∩ {(x - point) . normal <= 0} (box (2, 2); None if empty)."""
     lo, hi = box
-    poly = [np.array(p, float) for p in ((lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]),
-                                         (lo[0], hi[1]))]
+    poly = [
+        np.array(p, float) for p in ((lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1]))
+    ]
     s = [float(np.dot(p - point, normal)) for p in poly]
     out = []
     for k in range(4):  # Sutherland-Hodgman against one plane
@@ -115,8 +117,10 @@ def _scale(spec):
         boxes.append([np.min(pts, axis=0), np.max(pts, axis=0)])
     lo = np.min([np.asarray(b[0], float)[:2] for b in boxes], axis=0)
     hi = np.max([np.asarray(b[1], float)[:2] for b in boxes], axis=0)
-    r = max([b["shape"].get("radius", 0) for b in spec["bodies"]]
-            + [max(b["shape"].get("axes", [0])) for b in spec["bodies"]])
+    r = max(
+        [b["shape"].get("radius", 0) for b in spec["bodies"]]
+        + [max(b["shape"].get("axes", [0])) for b in spec["bodies"]]
+    )
     return float(np.max(hi - lo) + 2 * r)
 
 
@@ -137,8 +141,8 @@ def _markers(spec, frames, tol):
             def pred(x, bounds=bounds):
                 inside = np.ones(x.shape[1], dtype=bool)
                 for k, lo, hi in bounds:
-                    inside &= (x[k] >= (-np.inf if lo is None else lo - tol))
-                    inside &= (x[k] <= (np.inf if hi is None else hi + tol))
+                    inside &= x[k] >= (-np.inf if lo is None else lo - tol)
+                    inside &= x[k] <= (np.inf if hi is None else hi + tol)
                 return inside
 
         markers[b["name"]] = (tag, pred) if body is None else (tag, pred, body)
@@ -180,8 +184,11 @@ def _grid_lines(d, windows):
         c0, c1 = (a, c1) if c0 < a else (c0, c1)
         c0, c1 = (c0, b) if c1 > b else (c0, c1)
         try:
-            lines.append(graded_lines(a, b, (min(c0, c1), max(c0, c1)), h, d["growth"],
-                                      d["h_far"], required=req))
+            lines.append(
+                graded_lines(
+                    a, b, (min(c0, c1), max(c0, c1)), h, d["growth"], d["h_far"], required=req
+                )
+            )
         except ValueError as e:
             raise _error("discretization", f"{'xy'[ax]} lines: {e}") from None
     return lines
@@ -212,11 +219,18 @@ def _cut_scene(comm, spec):
             for ax, lines in enumerate((xl, yl)):
                 off = [v for v in w[:, ax] if np.min(np.abs(lines - v)) > tol]
                 if off:
-                    raise _error(f"bodies[{i}].window", f"{'xy'[ax]} = {off[0]:g} is not a grid "
-                                 "line (inside `fine` window bounds must be multiples of h)")
+                    why = (
+                        "the grid is uniform"
+                        if d["fine"] is None
+                        else "inside `fine`, lines are multiples of h"
+                    )
+                    raise _error(
+                        f"bodies[{i}].window", f"{'xy'[ax]} = {off[0]:g} is not a grid line ({why})"
+                    )
         else:
-            w = np.array([_snap(xl, bbox[0][0], bbox[1][0], tol),
-                          _snap(yl, bbox[0][1], bbox[1][1], tol)]).T
+            w = np.array(
+                [_snap(xl, bbox[0][0], bbox[1][0], tol), _snap(yl, bbox[0][1], bbox[1][1], tol)]
+            ).T
         if b["shape"]["type"] == "box":  # sides on the window are grid lines: push them out
             lo, hi = np.array(b["shape"]["min"][:2]), np.array(b["shape"]["max"][:2])
             lo = np.where(lo <= w[0] + tol, lo - margin, lo)
@@ -228,8 +242,16 @@ def _cut_scene(comm, spec):
     pairs = [(names.index(a), names.index(b)) for a, b in spec["pairs"]]
     markers = _markers(spec, windows, tol)
     try:
-        return cut_scene(comm, xl, yl, bodies, markers, pairs, d["h"],
-                         contact_box=_contact_box(spec, [f[1] for f in frames]))
+        return cut_scene(
+            comm,
+            xl,
+            yl,
+            bodies,
+            markers,
+            pairs,
+            d["h"],
+            contact_box=_contact_box(spec, [f[1] for f in frames]),
+        )
     except ValueError as e:
         raise _error("bodies", str(e)) from None
 
@@ -268,6 +290,16 @@ def _occ_body(occ, shape, window, size):
     return tags
 
 
+def _structured(gmsh, surface, size, quads):
+    """Rank 0: a transfinite (structured) mesh of a rectangle, about `size` per cell."""
+    for _, c in gmsh.model.getBoundary([(2, surface)], oriented=False):
+        x0, y0, _, x1, y1, _ = gmsh.model.getBoundingBox(1, c)
+        gmsh.model.mesh.setTransfiniteCurve(c, max(1, round(max(x1 - x0, y1 - y0) / size)) + 1)
+    gmsh.model.mesh.setTransfiniteSurface(surface)
+    if quads:
+        gmsh.model.mesh.setRecombine(2, surface)
+
+
 def _fitted_scene(comm, spec):
     import dolfinx_forms as df
 
@@ -294,15 +326,27 @@ def _fitted_scene(comm, spec):
     with gmsh_model(comm, spec["name"]) as gmsh:
         if comm.rank == 0:
             occ = gmsh.model.occ
+            surfaces = []
             for i, b in enumerate(spec["bodies"]):
-                if not _occ_body(occ, b["shape"], b["window"], size):
+                surfaces.append(_occ_body(occ, b["shape"], b["window"], size))
+                if not surfaces[-1]:
                     raise _error(f"bodies[{i}].window", "does not meet the shape")
             occ.synchronize()
             hq, far = (2 * h, 2 * d["h_far"]) if quads else (h, d["h_far"])
+            if d["structured"]:  # boxes: transfinite grids, spacing about h
+                for b, tags in zip(spec["bodies"], surfaces):
+                    if b["shape"]["type"] == "box" and b["window"] is None:
+                        _structured(gmsh, tags[0][1], hq, quads)
             f = gmsh.model.mesh.field.add("Box")
-            for k, v in dict(VIn=hq, VOut=far, XMin=fine[0][0], XMax=fine[1][0],
-                             YMin=fine[0][1], YMax=fine[1][1],
-                             Thickness=max(far - hq, 0.0) / d["slope"]).items():
+            for k, v in dict(
+                VIn=hq,
+                VOut=far,
+                XMin=fine[0][0],
+                XMax=fine[1][0],
+                YMin=fine[0][1],
+                YMax=fine[1][1],
+                Thickness=max(far - hq, 0.0) / d["slope"],
+            ).items():
                 gmsh.model.mesh.field.setNumber(f, k, float(v))
             gmsh.model.mesh.field.setAsBackgroundMesh(f)
             gmsh.option.setNumber("Mesh.RecombineAll", int(quads))

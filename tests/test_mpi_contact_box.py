@@ -12,8 +12,15 @@ import dolfinx_forms as df
 from dolfinx_forms.solver import ContactProblem
 from meshes.cut import CutBody, cut_scene, half_plane
 from meshes.patch import patch_dirichlet
-from meshes.scene import (Body, add_polygon, cell_bboxes, gmsh_model, on_box_side,
-                          pairs_contact_boxes, scene_from_gmsh)
+from meshes.scene import (
+    Body,
+    add_polygon,
+    cell_bboxes,
+    gmsh_model,
+    on_box_side,
+    pairs_contact_boxes,
+    scene_from_gmsh,
+)
 
 pytestmark = pytest.mark.mpi
 E, NU, D = 1.0, 0.3, 0.01
@@ -21,8 +28,10 @@ N = 24  # cells over the height: the derived box (+-4 h) is a strip, not the who
 
 
 def _markers(boxes, tol=1e-9):
-    return {"lower_bottom": (1, on_box_side(*boxes[0], ["bottom"], tol), 0),
-            "upper_top": (2, on_box_side(*boxes[1], ["top"], tol), 1)}
+    return {
+        "lower_bottom": (1, on_box_side(*boxes[0], ["bottom"], tol), 0),
+        "upper_top": (2, on_box_side(*boxes[1], ["top"], tol), 1),
+    }
 
 
 def cut_user_scene(comm, contact_box=None):
@@ -32,28 +41,44 @@ def cut_user_scene(comm, contact_box=None):
     lines = np.linspace(0.0, 1.0, N + 1)
     k = int(np.floor(y / h))
     windows = [np.array([[0.0, 0.0], [1.0, lines[k + 1]]]), np.array([[0.0, lines[k]], [1.0, 1.0]])]
-    bodies = [CutBody("lower", 1, windows[0], half_plane((0, y), (0, 1), 100.0),
-                      np.array([[0.0, 0.0], [1.0, y]])),
-              CutBody("upper", 2, windows[1], half_plane((0, y), (0, -1), 100.0),
-                      np.array([[0.0, y], [1.0, 1.0]]))]
-    return cut_scene(comm, lines, lines, bodies, _markers(windows), [(0, 1)], h,
-                     contact_box=contact_box)
+    bodies = [
+        CutBody(
+            "lower",
+            1,
+            windows[0],
+            half_plane((0, y), (0, 1), 100.0),
+            np.array([[0.0, 0.0], [1.0, y]]),
+        ),
+        CutBody(
+            "upper",
+            2,
+            windows[1],
+            half_plane((0, y), (0, -1), 100.0),
+            np.array([[0.0, y], [1.0, 1.0]]),
+        ),
+    ]
+    return cut_scene(
+        comm, lines, lines, bodies, _markers(windows), [(0, 1)], h, contact_box=contact_box
+    )
 
 
 def gmsh_user_scene(comm, contact_box=None):
     """Two stacked structured blocks meeting at y = 0.5, built with scene_from_gmsh directly."""
     boxes = [np.array([[0.0, 0.0], [1.0, 0.5]]), np.array([[0.0, 0.5], [1.0, 1.0]])]
-    bodies = [Body(n, i + 1, df.Box(*b), b) for i, (n, b) in enumerate(zip(("lower", "upper"),
-                                                                          boxes))]
+    bodies = [
+        Body(n, i + 1, df.Box(*b), b) for i, (n, b) in enumerate(zip(("lower", "upper"), boxes))
+    ]
     with gmsh_model(comm, "user") as gmsh:
         if comm.rank == 0:
             for lo, hi in boxes:
-                add_polygon(gmsh, [lo, (hi[0], lo[1]), hi, (lo[0], hi[1])], n=(N, N // 2),
-                            quads=True)
+                add_polygon(
+                    gmsh, [lo, (hi[0], lo[1]), hi, (lo[0], hi[1])], n=(N, N // 2), quads=True
+                )
             gmsh.model.geo.synchronize()
             gmsh.model.mesh.generate(2)
-        return scene_from_gmsh(comm, bodies, _markers(boxes), [(0, 1)], 1.0 / N,
-                               contact_box=contact_box)
+        return scene_from_gmsh(
+            comm, bodies, _markers(boxes), [(0, 1)], 1.0 / N, contact_box=contact_box
+        )
 
 
 BUILDERS = {"cut": cut_user_scene, "gmsh": gmsh_user_scene}
@@ -74,8 +99,15 @@ def owned_in_boxes(scene):
 
 
 def solve(scene):
-    p = ContactProblem(scene, {b.tag: (E, NU) for b in scene.bodies}, mu=0.0, eps0=1.0,
-                       band=0.5 / N, dirichlet=patch_dirichlet(D), log=lambda *a, **k: None)
+    p = ContactProblem(
+        scene,
+        {b.tag: (E, NU) for b in scene.bodies},
+        mu=0.0,
+        eps0=1.0,
+        band=0.5 / N,
+        dirichlet=patch_dirichlet(D),
+        log=lambda *a, **k: None,
+    )
     p.solve(1)
     pts = p.contact_points()
     pn = np.concatenate([q["p_n"] for q in pts]) if pts else np.zeros(0)

@@ -14,8 +14,13 @@ import pytest
 from mpi4py import MPI
 
 from dolfinx_forms.cli import DemoParser
-from dolfinx_forms.folders import (MARKER, OutputFolderError, atomic_output_dir,
-                                   check_output_path, read_marker)
+from dolfinx_forms.folders import (
+    MARKER,
+    OutputFolderError,
+    atomic_output_dir,
+    check_output_path,
+    read_marker,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 NOT_OURS = "exists and is not a result folder of this code (use another path or --force)"
@@ -107,10 +112,16 @@ def test_refused_paths(tmp_path, monkeypatch):
     f = tmp_path / "file"
     f.write_text("x")
     monkeypatch.chdir(tmp_path)
-    cases = {"": "must be a folder path", ".": "the current folder",
-             str(tmp_path): "the current folder", "..": "a parent of the current folder",
-             "/": "the filesystem root", str(Path.home()): "the home folder",
-             str(f): "exists and is not a folder", str(f / "sub"): "is not a folder"}
+    cases = {
+        "": "must be a folder path",
+        ".": "the current folder",
+        str(tmp_path): "the current folder",
+        "..": "a parent of the current folder",
+        "/": "the filesystem root",
+        str(Path.home()): "the home folder",
+        str(f): "exists and is not a folder",
+        str(f / "sub"): "is not a folder",
+    }
     for text, what in cases.items():
         for force in (False, True):
             with pytest.raises(OutputFolderError, match=what) as e:
@@ -132,7 +143,8 @@ def test_failure_leaves_nothing(tmp_path):
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_signal_while_writing(tmp_path, sig):
     """A signal while the results are written: no folder under the final name, no leftovers."""
-    script = textwrap.dedent(f"""
+    script = textwrap.dedent(
+        f"""
         import time, sys
         from pathlib import Path
         from mpi4py import MPI
@@ -141,9 +153,15 @@ def test_signal_while_writing(tmp_path, sig):
             (tmp / "part.csv").write_text("half")
             print("writing", flush=True)
             time.sleep(60)
-    """)
-    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True,
-                         stderr=subprocess.DEVNULL, cwd=tmp_path)
+    """
+    )
+    p = subprocess.Popen(
+        [sys.executable, "-c", script],
+        stdout=subprocess.PIPE,
+        text=True,
+        stderr=subprocess.DEVNULL,
+        cwd=tmp_path,
+    )
     try:
         assert p.stdout.readline().strip() == "writing"
         assert len(list(tmp_path.iterdir())) == 1  # the temporary folder, hidden
@@ -172,16 +190,40 @@ def test_demo_refuses_foreign_out_before_computing(tmp_path):
     out.mkdir()
     (out / "data.txt").write_text("keep")
     t0 = time.perf_counter()
-    r = subprocess.run([sys.executable, str(ROOT / "demos" / "patch_test.py"), "--out", str(out),
-                        "--discretization", "cut"], capture_output=True, text=True, cwd=tmp_path)
+    r = subprocess.run(
+        [
+            sys.executable,
+            str(ROOT / "demos" / "patch_test.py"),
+            "--out",
+            str(out),
+            "--discretization",
+            "cut",
+        ],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
     assert r.returncode == 2, r.stderr
     lines = [ln for ln in r.stderr.splitlines() if "mca_base" not in ln]
     assert lines == [f"patch_test.py: error: --out: {out} {NOT_OURS}"]
     assert listing(tmp_path) == ["mine", "mine/data.txt"]
     assert time.perf_counter() - t0 < 60
-    r = subprocess.run([sys.executable, str(ROOT / "demos" / "patch_test.py"), "--out", str(out),
-                        "--discretization", "cut", "--h", "0.2", "--force"],
-                       capture_output=True, text=True, cwd=tmp_path)
+    r = subprocess.run(
+        [
+            sys.executable,
+            str(ROOT / "demos" / "patch_test.py"),
+            "--out",
+            str(out),
+            "--discretization",
+            "cut",
+            "--h",
+            "0.2",
+            "--force",
+        ],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
     assert r.returncode == 0, r.stderr
     assert (out / "data.txt").read_text() == "keep"
     assert json.loads((out / "metrics.json").read_text())["benchmark"] == "patch"

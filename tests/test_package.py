@@ -58,39 +58,43 @@ def test_help_shows_defaults(demo, capsys):
     assert len(parser_defaults) >= 2, text
 
 
-def _compile_tiny_form(cache, env_extra):
-    """A fresh JIT cache: FFCx generates and cffi compiles one form in a child process."""
-    script = textwrap.dedent(f"""
-        import dolfinx_forms  # noqa: F401  (configures the loggers)
+def _compile_tiny_form(cache, verbose_env=False, verbose_flag=False):
+    """A fresh JIT cache: FFCx generates and cffi compiles one form in a child process (a
+    program with the shared parser, given --verbose or not)."""
+    script = textwrap.dedent(
+        f"""
         import sys
         import ufl
         from dolfinx import fem, mesh
         from mpi4py import MPI
-        {"from dolfinx_forms.logs import set_verbose; set_verbose(True)" if
-         env_extra.pop("_flag", False) else ""}
+        from dolfinx_forms.cli import DemoParser
+
+        DemoParser(prog="tiny.py").parse_args(sys.argv[1:])
         m = mesh.create_unit_square(MPI.COMM_SELF, 1, 1)
         V = fem.FunctionSpace(m, ("Lagrange", 1))
         u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
         fem.form(1.2345 * ufl.inner(u, v) * ufl.dx, jit_params={{"cache_dir": {str(cache)!r}}})
         print("compiled", flush=True)
-    """)
-    env = dict(os.environ, XDG_CACHE_HOME=str(cache), **env_extra)
-    env.pop("ILS_VERBOSE", None) if "ILS_VERBOSE" not in env_extra else None
-    r = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env,
-                       timeout=300)
+        """
+    )
+    env = {k: v for k, v in os.environ.items() if k != "ILS_VERBOSE"}
+    env.update(XDG_CACHE_HOME=str(cache), **({"ILS_VERBOSE": "1"} if verbose_env else {}))
+    args = ["--verbose"] if verbose_flag else []
+    r = subprocess.run(
+        [sys.executable, "-c", script, *args], capture_output=True, text=True, env=env, timeout=300
+    )
     assert r.returncode == 0, r.stderr
     assert any(cache.rglob("*.so")), "nothing was compiled: the cache was not fresh"
     return r.stdout + r.stderr
 
 
 def test_jit_quiet_on_fresh_cache(tmp_path):
-    out = _compile_tiny_form(tmp_path / "quiet", {})
+    out = _compile_tiny_form(tmp_path / "quiet")
     assert "compiled" in out
     assert [ln for ln in out.splitlines() if "INFO" in ln] == []
 
 
 @pytest.mark.parametrize("how", ["env", "flag"])
 def test_jit_verbose_on_request(tmp_path, how):
-    extra = {"ILS_VERBOSE": "1"} if how == "env" else {"_flag": True}
-    out = _compile_tiny_form(tmp_path / how, extra)
+    out = _compile_tiny_form(tmp_path / how, verbose_env=how == "env", verbose_flag=how == "flag")
     assert "INFO:root" in out

@@ -29,10 +29,21 @@ def patch_problem(scene, tractions=(), log=lambda *a, **k: None):
         return lambda x: np.isclose(x[0], 0.0) & np.isclose(x[1], y)
 
     top = Dirichlet("upper_top", 1, 0.0)
-    bcs = [Dirichlet("lower_bottom", 1, 0.0), top, Dirichlet(corner(0.0), 0, 0.0),
-           Dirichlet(corner(1.0), 0, 0.0)]
-    p = ContactProblem(scene, {b.tag: (E, NU) for b in scene.bodies}, eps0=1.0, band=0.5 / N,
-                       dirichlet=bcs, tractions=tractions, log=log)
+    bcs = [
+        Dirichlet("lower_bottom", 1, 0.0),
+        top,
+        Dirichlet(corner(0.0), 0, 0.0),
+        Dirichlet(corner(1.0), 0, 0.0),
+    ]
+    p = ContactProblem(
+        scene,
+        {b.tag: (E, NU) for b in scene.bodies},
+        eps0=1.0,
+        band=0.5 / N,
+        dirichlet=bcs,
+        tractions=tractions,
+        log=log,
+    )
     return p, top
 
 
@@ -76,8 +87,9 @@ def test_ramp_moves_tractions_and_holds_them(scene):
     assert np.allclose(problem.u.x.array, u1, atol=1e-14)
     protocol.ramp(problem, side, 0.0)  # the side load removed, the top held
     assert protocol.current_value(problem, top) == pytest.approx(-0.005)
-    assert problem.reaction("upper_top")[1] == pytest.approx(penalised_reaction(problem, 0.005),
-                                                             rel=1e-9)
+    assert problem.reaction("upper_top")[1] == pytest.approx(
+        penalised_reaction(problem, 0.005), rel=1e-9
+    )
 
 
 @pytest.mark.parametrize("monotone", [False, True])
@@ -85,8 +97,9 @@ def test_reach_force(scene, monotone):
     problem, top = patch_problem(scene)
     target, tol = -0.004, 1e-6
     # monotone: approach from below (a first guess short of the answer -0.00497)
-    rec = protocol.reach_force(problem, top, "upper_top", 1, target, first_guess=-0.002,
-                               tol=tol, monotone=monotone)
+    rec = protocol.reach_force(
+        problem, top, "upper_top", 1, target, first_guess=-0.002, tol=tol, monotone=monotone
+    )
     force = problem.reaction("upper_top")[1]
     assert abs(force - target) <= tol * abs(target)
     assert rec.force[1] == pytest.approx(force, rel=1e-12)
@@ -99,12 +112,12 @@ def test_reach_force(scene, monotone):
 def test_reach_force_failures(scene):
     problem, top = patch_problem(scene)
     with pytest.raises(ContactSolverError, match="did not reach"):
-        protocol.reach_force(problem, top, "upper_top", 1, -0.004, first_guess=-0.001,
-                             max_iter=1)
+        protocol.reach_force(problem, top, "upper_top", 1, -0.004, first_guess=-0.001, max_iter=1)
     # monotone loading refuses to go back
     with pytest.raises(ContactSolverError, match="reverse"):
-        protocol.reach_force(problem, top, "upper_top", 1, -0.0005, first_guess=-0.002,
-                             monotone=True)
+        protocol.reach_force(
+            problem, top, "upper_top", 1, -0.0005, first_guess=-0.002, monotone=True
+        )
 
 
 def test_friction_on(scene):

@@ -1,5 +1,6 @@
 // Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
 #include "contact_kernel.h"
+#include "gaps.h"
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -117,20 +118,19 @@ ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPena
         Bt[2 * a + c] = N[a] * t[c];
       }
     }
-    double jn = 0.0, jt = 0.0;
-    for (std::size_t a = 0; a < nd; ++a) {
-      for (std::size_t c = 0; c < 2; ++c) {
-        const double ua = u[2 * std::size_t(dofs[a]) + c];
-        jn += Bn[2 * a + c] * ua;
-        jt += Bt[2 * a + c] * ua;
-      }
-    }
+    // Displacement jump u_j(P_j) - u_i(P_i) (eq 26) and the gaps (eqs 27-30)
+    std::array<double, 2> du = {0.0, 0.0};
+    for (std::size_t a = 0; a < nd; ++a)
+      for (std::size_t c = 0; c < 2; ++c)
+        du[c] += N[a] * u[2 * std::size_t(dofs[a]) + c];
+    const PointGaps gaps = point_gaps(q.g_n0[p], du, std::span<const double, 2>(n, 2),
+                                      std::span<const double, 2>(t, 2));
     const double gtp0 = friction ? gtp_old[p] : 0.0;
     const double w = q.weights[p];
     double gtp = 0.0;
     std::array<double, 4> D;
-    s.g_n[p] = q.g_n0[p] + jn;
-    s.g_t[p] = jt;
+    s.g_n[p] = gaps.g_n;
+    s.g_t[p] = gaps.g_t;
     point_law(law, s.g_n[p], s.g_t[p], gtp0, s.tau_n[p], s.tau_t[p], gtp, s.state[p], D);
     if (friction)
       s.gtp_trial[p] = gtp;

@@ -54,7 +54,8 @@ enum class TangentMode { exact, finite_difference };
 
 /// @brief Contact residual and tangent of eq 48 for a body pair.
 ///
-/// At each point: g_n = g_n0 + (u_j(P_j) - u_i(P_i)).n, g_t = (u_j - u_i).t, the return
+/// At each point: g_n = g_n0 + (u_j(P_j) - u_i(P_i)).n, g_t = (u_j - u_i).t (`point_gaps`,
+/// gaps.h, with u interpolated at P_i and P_j by the basis values), the return
 /// mapping (Algorithm 1) gives tau_n, tau_t and D = d[tau_n, tau_t]/d[g_n, g_t], and with
 /// B = [n t]^T [-N_i, N_j] (2 x 2nd):  r += w B^T [tau_n, tau_t],  K += w B^T D B.
 /// Open points add nothing. With mu == 0 the tangential row is skipped altogether (no

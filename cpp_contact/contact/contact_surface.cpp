@@ -1,5 +1,6 @@
 // Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
 #include "contact_surface.h"
+#include "contour.h"
 #include "reinit.h"
 #include <algorithm>
 #include <cmath>
@@ -89,10 +90,11 @@ LevelSet contact::closing_levelset(const LevelSet& phi_i, const LevelSet& phi_j,
   if (!(eps > 0) or !std::isfinite(eps))
     throw std::invalid_argument("contact region: eps must be a finite length > 0");
   check_same_grid(phi_i, phi_j, "closing_levelset");
-  // Dilate the union by eps, make it a distance again, erode by eps (eq 22)
-  std::vector<double> v(phi_i.values().size());
-  for (std::size_t k = 0; k < v.size(); ++k)
-    v[k] = std::min(phi_i.values()[k], phi_j.values()[k]) - eps;
+  // Dilate the union (eq 21) by eps, make it a distance again, erode by eps (eq 22)
+  const LevelSet phi_min = min_levelset(phi_i, phi_j);
+  std::vector<double> v(phi_min.values().begin(), phi_min.values().end());
+  for (double& x : v)
+    x -= eps;
   // Without a zero contour in the grid, the dilated union covers all of it (every
   // node is then in the closing) or none of it: a constant of the right sign
   // larger than any distance in the grid says so without a reinitialisation.
@@ -117,7 +119,7 @@ std::vector<std::int8_t> contact::contact_region(const LevelSet& phi_i, const Le
   const auto a = phi_i.values(), b = phi_j.values(), c = psi.values();
   std::vector<std::int8_t> flags(a.size());
   for (std::size_t k = 0; k < a.size(); ++k)
-    flags[k] = (a[k] > 0 and b[k] > 0 and c[k] < 0) or (a[k] < 0 and b[k] < 0);
+    flags[k] = region_indicator(a[k], b[k], c[k]) < 0;
   return flags;
 }
 
@@ -134,21 +136,14 @@ ContactSurface contact::contact_surface(const LevelSet& phi_i, const LevelSet& p
   const auto v = phi.values();
   const double h = grid.min_spacing();
 
-  // Region indicator on Gamma_int: psi < 0 (bridge) or phi_i = phi_j < 0 (overlap)
+  // Region indicator (eq 22) on Gamma_int, where phi_i = phi_j: both at their mean
   auto region = [&](std::array<double, 2> x) {
     std::span<const double, 2> xs(x.data(), 2);
-    return std::min(psi.eval(xs), 0.5 * (phi_i.eval(xs) + phi_j.eval(xs)));
+    const double m = 0.5 * (phi_i.eval(xs) + phi_j.eval(xs));
+    return region_indicator(m, m, psi.eval(xs));
   };
   auto phi_at = [&](std::array<double, 2> x) {
     return phi.eval(std::span<const double, 2>(x.data(), 2));
-  };
-
-  // Zero of phi on the grid edge from node a to node b (always from the lower
-  // index, so both cells sharing an edge find bitwise the same point)
-  auto edge_root = [&](std::array<double, 2> a, std::array<double, 2> b, double fa, double fb) {
-    auto f = [&](double t) { return phi_at({a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])}); };
-    const double t = bracketed_root(f, fa, fb);
-    return std::array<double, 2>{a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])};
   };
 
   ContactSurface s;
@@ -157,43 +152,27 @@ ContactSurface contact::contact_surface(const LevelSet& phi_i, const LevelSet& p
 
   for (std::size_t j = 0; j + 1 < ay.size(); ++j)
     for (std::size_t i = 0; i + 1 < ax.size(); ++i) {
-      // Corners in tensor order (0,0), (1,0), (0,1), (1,1); zero counts as positive
-      const double f[4] = {v[grid.node(i, j)], v[grid.node(i + 1, j)], v[grid.node(i, j + 1)],
-                           v[grid.node(i + 1, j + 1)]};
-      const bool neg[4] = {f[0] < 0, f[1] < 0, f[2] < 0, f[3] < 0};
-      if (neg[0] == neg[1] and neg[0] == neg[2] and neg[0] == neg[3])
-        continue;
-      const std::array<double, 2> X[4] = {
-          {ax[i], ay[j]}, {ax[i + 1], ay[j]}, {ax[i], ay[j + 1]}, {ax[i + 1], ay[j + 1]}};
-      // Edges: bottom (0,1), right (1,3), top (2,3), left (0,2)
-      static const int E[4][2] = {{0, 1}, {1, 3}, {2, 3}, {0, 2}};
-      std::array<double, 2> cross[4];
-      bool has[4];
-      for (int e = 0; e < 4; ++e) {
-        const int a = E[e][0], b = E[e][1];
-        has[e] = neg[a] != neg[b];
-        if (has[e])
-          cross[e] = edge_root(X[a], X[b], f[a], f[b]);
-      }
-      // Pair the crossings into segments
-      std::vector<std::array<int, 2>> pairs;
-      if (has[0] and has[1] and has[2] and has[3]) {
-        // Saddle: decide with the interpolant at the cell centre
-        const double fc = phi_at({0.5 * (ax[i] + ax[i + 1]), 0.5 * (ay[j] + ay[j + 1])});
-        if ((fc < 0) == neg[0])
-          pairs = {{0, 1}, {3, 2}}; // diagonal 0-3 connected: cut off corners 1 and 2
-        else
-          pairs = {{3, 0}, {1, 2}}; // cut off corners 0 and 3
-      } else {
-        int e0 = -1, e1 = -1;
-        for (int e = 0; e < 4; ++e)
-          if (has[e])
-            (e0 < 0 ? e0 : e1) = e;
-        pairs = {{e0, e1}};
-      }
+      // Corners in tensor order (0,0), (1,0), (0,1), (1,1)
+      const std::array<double, 4> f = {v[grid.node(i, j)], v[grid.node(i + 1, j)],
+                                       v[grid.node(i, j + 1)], v[grid.node(i + 1, j + 1)]};
+      const std::array<std::array<double, 2>, 4> X = {
+          {{ax[i], ay[j]}, {ax[i + 1], ay[j]}, {ax[i], ay[j + 1]}, {ax[i + 1], ay[j + 1]}}};
+      // Marching squares on the C1 interpolant: edge crossings by bracketed root finding along
+      // the edge (from its lower node, so both cells sharing it find bitwise the same point),
+      // saddles by the interpolant at the cell centre
+      auto edge_root = [&](int e, double fa, double fb) {
+        auto fe = [&](double t) { return phi_at(edge_point(X, e, t)); };
+        return bracketed_root(fe, fa, fb);
+      };
+      auto centre = [&]() {
+        return phi_at({0.5 * (ax[i] + ax[i + 1]), 0.5 * (ay[j] + ay[j + 1])});
+      };
+      const CellContour contour = cell_contour(f, edge_root, centre);
 
-      for (auto [ea, eb] : pairs) {
-        std::array<double, 2> p = cross[ea], q = cross[eb];
+      for (int sgm = 0; sgm < contour.num_segments; ++sgm) {
+        const auto [ea, eb] = contour.segments[sgm];
+        std::array<double, 2> p = edge_point(X, ea, contour.t[ea]);
+        std::array<double, 2> q = edge_point(X, eb, contour.t[eb]);
         // Clip to the contact region (eqs 22, 24)
         const double rp = region(p), rq = region(q);
         if (rp >= 0 and rq >= 0)

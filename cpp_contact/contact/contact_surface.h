@@ -2,12 +2,14 @@
 #pragma once
 
 #include "levelset.h"
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
 namespace contact {
 
-/// @brief Minimum level set phi_min = min(phi_i, phi_j) at the nodes (eq 21).
+/// @brief Minimum level set phi_min = min(phi_i, phi_j) at the nodes (eq 21), the union of
+/// the two bodies; `closing_levelset` builds on it.
 /// @throws std::invalid_argument if the grids differ
 LevelSet min_levelset(const LevelSet& phi_i, const LevelSet& phi_j);
 
@@ -18,14 +20,29 @@ LevelSet min_levelset(const LevelSet& phi_i, const LevelSet& phi_j);
 /// @throws std::invalid_argument if the grids differ
 LevelSet intermediate_levelset(const LevelSet& phi_i, const LevelSet& phi_j);
 
-/// @brief Closing level set psi = reinitialize(phi_min - eps) + eps (eq 22).
+/// @brief Closing level set psi = reinitialize(phi_min - eps) + eps (eq 22), phi_min from
+/// `min_levelset` (eq 21).
 ///
 /// psi < 0 on the union of the bodies and on the "liquid bridges" narrower than
 /// about 2 eps between them.
 LevelSet closing_levelset(const LevelSet& phi_i, const LevelSet& phi_j, double eps);
 
+/// @brief Contact-region indicator (eq 22, extended to overlaps): the one definition of the
+/// contact region Omega_c.
+///
+/// From the values of phi_i, phi_j and the closing psi (`closing_levelset`) at a point,
+///   r = min(max(-phi_i, -phi_j, psi), max(phi_i, phi_j)),
+/// which is negative exactly on
+///   Omega_c = {phi_i > 0 and phi_j > 0 and psi < 0} U {phi_i < 0 and phi_j < 0}:
+/// the "liquid bridge" outside both bodies but close to both, and the penetrated overlap.
+/// It is continuous, so Omega_c can be clipped by root finding. `contact_region` flags the
+/// nodes where r < 0; `contact_surface` clips Gamma_int where r changes sign.
+inline double region_indicator(double phi_i, double phi_j, double psi) {
+  return std::min(std::max({-phi_i, -phi_j, psi}), std::max(phi_i, phi_j));
+}
+
 /// @brief Node flags of the contact region (eq 22) extended to overlaps:
-/// (phi_i > 0 and phi_j > 0 and psi < 0) or (phi_i < 0 and phi_j < 0).
+/// `region_indicator` < 0 at the node.
 std::vector<std::int8_t> contact_region(const LevelSet& phi_i, const LevelSet& phi_j, double eps);
 
 /// @brief Candidate contact surface Gamma_c (eq 24) with its quadrature.
@@ -42,10 +59,12 @@ struct ContactSurface {
 /// @brief Zero contour of phi_int restricted to the contact region (eqs 22-24).
 ///
 /// In each grid cell crossed by phi_int = 0 the contour is a straight segment
-/// between its edge crossings (found on the C1 interpolant by bracketed root
-/// finding; saddle cells resolved by the value at the cell centre). On Gamma_int
-/// phi_i = phi_j, so the region test reduces to psi < 0 and a segment is clipped
-/// where psi changes sign; overlapping (penetrated) parts are always kept.
+/// between its edge crossings (`cell_contour`, the marching squares of the cut cells; here the
+/// crossings are roots of the C1 interpolant by bracketed root finding and saddle cells are
+/// resolved by its value at the cell centre). Each segment is clipped to the contact region
+/// where `region_indicator` changes sign, evaluated with phi_i = phi_j = (phi_i + phi_j) / 2
+/// (their common value on Gamma_int): in the bridge it changes sign with psi, and
+/// overlapping (penetrated) parts are always kept.
 /// Each segment carries `num_gauss` Gauss-Legendre points.
 /// @param[in] phi_i, phi_j Level sets of the two bodies on the same grid
 /// @param[in] eps Shift parameter of eq 22 (> 0), a length

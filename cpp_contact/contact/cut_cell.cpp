@@ -1,5 +1,6 @@
 // Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
 #include "cut_cell.h"
+#include "contour.h"
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -104,23 +105,24 @@ int clip_square(std::span<const double, 4> phi, std::span<double, 6 * max_triang
   if (n_in == 0)
     return 0;
 
-  // Walk the boundary counter-clockwise from an inside corner: inside corners and the edge
-  // crossings, so poly[0] is a corner.
+  // The zero contour (marching squares, shared with the contact surface Gamma_c)
+  const CellContour contour = cell_contour(phi);
+
+  // Walk the boundary counter-clockwise from an inside corner: inside corners and the contour's
+  // edge crossings, so poly[0] is a corner. The edge from ccw[k] to ccw[k + 1] is cell edge k.
   int k0 = 0;
   while (not in[ccw[k0]])
     ++k0;
   std::array<double, 16> poly; // at most 8 points
-  int np = 0, n_cross = 0;
+  int np = 0;
   for (int k = k0; k < k0 + 4; ++k) {
-    const int a = ccw[k % 4], b = ccw[(k + 1) % 4];
+    const int a = ccw[k % 4], e = k % 4;
     if (in[a]) {
       poly[2 * np] = corner[a][0], poly[2 * np + 1] = corner[a][1], ++np;
     }
-    if (in[a] != in[b]) {
-      const double t = phi[a] / (phi[a] - phi[b]);
-      poly[2 * np] = corner[a][0] + t * (corner[b][0] - corner[a][0]);
-      poly[2 * np + 1] = corner[a][1] + t * (corner[b][1] - corner[a][1]);
-      ++np, ++n_cross;
+    if (contour.crossed[e]) {
+      const std::array<double, 2> x = edge_point(corner, e, contour.t[e]);
+      poly[2 * np] = x[0], poly[2 * np + 1] = x[1], ++np;
     }
   }
 
@@ -131,8 +133,7 @@ int clip_square(std::span<const double, 4> phi, std::span<double, 6 * max_triang
     if (area(t) > 0) // drop the zero-area triangles of crossings at a vertex
       ++nt;
   };
-  const double centre = 0.25 * (phi[0] + phi[1] + phi[2] + phi[3]);
-  if (n_cross == 4 and centre >= 0) {
+  if (contour.num_segments == 2 and not contour.centre_inside) {
     // Saddle with the centre outside: two separate corner triangles. The walk gave
     // [corner, crossing, crossing, corner, crossing, crossing].
     emit(&poly[0], &poly[2], &poly[10]);
@@ -167,7 +168,7 @@ std::array<double, 2> clip_segment(double phi0, double phi1) {
     return {0.0, 1.0};
   if (not in0 and not in1)
     return {0.0, 0.0};
-  const double t = phi0 / (phi0 - phi1);
+  const double t = linear_root(phi0, phi1); // the crossing of `cell_contour` on this edge
   return in0 ? std::array<double, 2>{0.0, t} : std::array<double, 2>{t, 1.0};
 }
 

@@ -11,7 +11,8 @@
 // {phi < 0}. Inside a cut cell the zero contour is the straight segment between the zero
 // crossings of phi on the cell edges (linear interpolation along each edge); when the four
 // edges all carry a crossing (saddle) the centre value (mean of the four) decides whether the
-// two inside corners are connected.
+// two inside corners are connected. That contour is `contact::cell_contour` (contour.h), the
+// marching squares that the contact surface Gamma_c uses too.
 
 #include <array>
 #include <cstdint>

@@ -29,16 +29,14 @@ void compute_gaps(std::span<const double> p_i, std::span<const double> p_j,
   check(j_int.size(), n, "j_int", "n");
   check(g_t.size(), n, "g_t", "n");
 
+  auto point = [](std::span<const double> a, std::size_t p) { return a.subspan(2 * p).first<2>(); };
   for (std::size_t p = 0; p < n; ++p) {
-    const std::size_t x = 2 * p, y = 2 * p + 1;
-    const double dp0 = p_j[x] - p_i[x], dp1 = p_j[y] - p_i[y];
-    const double du0 = u_j[x] - u_i[x], du1 = u_j[y] - u_i[y];
-    const double gn0 = dp0 * normals[x] + dp1 * normals[y]; // eq 28
-    const double jn = du0 * normals[x] + du1 * normals[y];  // eq 29
-    g_n0[p] = gn0;
-    j_int[p] = jn;
-    g_n[p] = gn0 + jn;                              // eq 27
-    g_t[p] = du0 * tangents[x] + du1 * tangents[y]; // eq 30
+    const double du[2] = {u_j[2 * p] - u_i[2 * p], u_j[2 * p + 1] - u_i[2 * p + 1]};
+    g_n0[p] = initial_normal_gap(point(p_i, p), point(p_j, p), point(normals, p)); // eq 28
+    const PointGaps g = point_gaps(g_n0[p], du, point(normals, p), point(tangents, p));
+    j_int[p] = g.j_int;
+    g_n[p] = g.g_n;
+    g_t[p] = g.g_t;
   }
 }
 //-----------------------------------------------------------------------------

@@ -2,9 +2,11 @@
 // Cut cells: the kernels' addresses for custom integrals in dolfinx Forms, their coefficient
 // layout, vectorised cut quadrature (tests, diagnostics), and the ghost-penalty couplings.
 #include "array.h"
+#include <contact/contour.h>
 #include <contact/cut_cell.h>
 #include <cstdint>
 #include <dolfinx/la/SparsityPattern.h>
+#include <limits>
 #include <pybind11/stl.h>
 
 namespace py = pybind11;
@@ -66,6 +68,37 @@ void bind_cut(py::module_& m) {
         return to_numpy(std::move(f), {py::ssize_t(f.size())});
       },
       py::arg("phi"), "Inside area fraction of each cell, phi (n, 4) in tensor order");
+  m.def(
+      "cell_contours",
+      [](const carray& phi) {
+        const auto p = as_span(phi, "phi", 4);
+        const std::size_t n = p.size() / 4;
+        std::vector<double> t(4 * n);
+        std::vector<std::int8_t> seg(4 * n, -1), ns(n);
+        for (std::size_t c = 0; c < n; ++c) {
+          const contact::CellContour k =
+              contact::cell_contour(std::span<const double, 4>(p.data() + 4 * c, 4));
+          for (int e = 0; e < 4; ++e)
+            t[4 * c + e] = k.crossed[e] ? k.t[e] : std::numeric_limits<double>::quiet_NaN();
+          for (int s = 0; s < k.num_segments; ++s)
+            for (int a = 0; a < 2; ++a)
+              seg[4 * c + 2 * s + a] = std::int8_t(k.segments[s][a]);
+          ns[c] = std::int8_t(k.num_segments);
+        }
+        const auto nn = py::ssize_t(n);
+        py::dict d;
+        d["t"] = to_numpy(std::move(t), {nn, 4});
+        d["segments"] = to_numpy(std::move(seg), {nn, 2, 2});
+        d["num_segments"] = to_numpy(std::move(ns), {nn});
+        d["edges"] = contact::cell_edges;
+        return d;
+      },
+      py::arg("phi"),
+      "Zero contour of the bilinear interpolant in each cell (marching squares, "
+      "contact/contour.h): phi (n, 4) vertex values (tensor order) -> t (n, 4) crossing of "
+      "edge e at X[a] + t (X[b] - X[a]), (a, b) = edges[e], NaN where not crossed; segments "
+      "(n, 2, 2) the two edges each segment joins (-1 unused); num_segments (n,) 0, 1 or 2; "
+      "edges (4, 2)");
   m.def(
       "cut_moment_weights",
       [](const carray& phi, const carray& points) {

@@ -1,0 +1,225 @@
+"""Scene descriptions (demos/scenes/*.toml) run by `python3 -m dolfinx_forms run`.
+
+End to end (one subprocess per case): the Hertz scene at h = a/10 (coarse; a/20 is the
+default) against Hertz at the computed load (a within 2 %, p0 within 4 %: the element-scale
+penalty ripple of the point values at this h), the cut patch test to round-off against the
+penalised exact pressure E' d / (H + E' eps_n), a failed check (exit 1, reason, results
+written), bad descriptions (exit 2, one line naming the key, nothing written). The description
+checks are in-process (scene_spec is pure Python), so is the fitted (gmsh) path of the builder.
+"""
+
+import json
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dolfinx_forms import analytic
+from dolfinx_forms.scene_spec import SpecError, load
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENES = ROOT / "demos" / "scenes"
+
+
+def run(*args, cwd=ROOT):
+    return subprocess.run(
+        [sys.executable, "-m", "dolfinx_forms", *map(str, args)],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"},
+    )
+
+
+def metrics(out):
+    return json.loads((Path(out) / "metrics.json").read_text())
+
+
+def test_hertz_scene(tmp_path):
+    out = tmp_path / "hertz"
+    r = run(
+        "run",
+        SCENES / "hertz.toml",
+        "--out",
+        out,
+        "--set",
+        "discretization.h=0.1",
+        "--set",
+        "checks[1].rtol=0.04",
+        "--set",
+        "checks[2].below=0.05",
+    )
+    assert r.returncode == 0, r.stderr
+    m = metrics(out)
+    assert m["benchmark"] == "hertz" and m["discretization"] == "cut"
+    assert m["mesh"]["h_contact"] == 0.1 and m["solver"]["converged"]
+    res = m["results"]
+    P = res["reaction"][1]
+    assert P == pytest.approx(430.0, rel=1e-3)
+    a, p0 = analytic.hertz_line(P, 10.0, analytic.effective_modulus(1e4, 0.3, 1e4, 0.3))
+    assert res["contact_half_width"] == pytest.approx(a, rel=0.02)
+    assert res["peak_pressure"] == pytest.approx(p0, rel=0.04)
+    assert m["analytic"]["contact_half_width"] == pytest.approx(a, rel=1e-12)
+    assert m["checks_passed"] and len(m["checks"]) == 5
+    assert [s["kind"] for s in m["stages"]] == ["force"]
+    assert m["stages"][0]["values"]["top_y"] < 0
+    for f in ("tractions.csv", "tractions.png", "solution.xdmf", "solution.h5"):
+        assert (out / f).exists(), f
+    assert "normal: reaction y on block_bottom" in r.stdout
+
+
+def test_patch_scene(tmp_path):
+    out = tmp_path / "patch"
+    r = run("run", SCENES / "patch.toml", "--out", out)
+    assert r.returncode == 0, r.stderr
+    m = metrics(out)
+    E, nu, d, h = 1.0, 0.3, 0.01, 0.125
+    Ep = E / (1 - nu**2)
+    eps_n = 1.0 * h / E  # eq 51, eps0 = 1
+    assert m["solver"]["penalty"]["eps_n"] == pytest.approx(eps_n)
+    penalised = Ep * d / (1.0 + Ep * eps_n)
+    t = np.genfromtxt(out / "tractions.csv", delimiter=",", names=True, dtype=None, encoding=None)
+    assert set(t["state"]) <= {"stick", "slip"}  # all active
+    assert np.max(np.abs(t["p_n"] - penalised)) <= 1e-8 * penalised
+    assert np.max(np.abs(t["p_t"])) <= 1e-12
+    assert m["results"]["reaction"][1] == pytest.approx(penalised, rel=1e-8)
+    assert m["analytic"]["pressure"] == pytest.approx(0.010989011, rel=1e-8)
+    assert m["checks_passed"]
+
+
+def test_failed_check(tmp_path):
+    """A check that fails: exit 1 with the reason, the results (and the verdict) written."""
+    out = tmp_path / "patch"
+    r = run("run", SCENES / "patch.toml", "--out", out, "--set", "checks[1].below=-1.0")
+    assert r.returncode == 1
+    assert "check 'results.shear_max' failed" in r.stderr and "is not <= -1" in r.stderr
+    m = metrics(out)
+    assert m["checks_passed"] is False
+    assert [c["passed"] for c in m["checks"]] == [True, False, True, True]
+
+
+@pytest.mark.parametrize(
+    "args,key",
+    [
+        (["--set", "bodies[0].law.nu=0.5"], "bodies[0].law.nu"),  # while reading
+        (["--set", "stages=[{kind='ramp', to={nope=1.0}}]"], "stages[0].to.nope"),
+        (["--set", "bodies[0].window=[[0.0,0.0],[1.0,0.6]]"], "bodies[0].window"),  # the grid
+        (["--set", "dirichlet[2].point=[0.1,0.0]"], "dirichlet[2].point"),  # the mesh
+    ],
+)
+def test_bad_description(tmp_path, args, key):
+    out = tmp_path / "never"
+    r = run("run", SCENES / "patch.toml", "--out", out, *args)
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and f"error: {key}:" in lines[0], r.stderr
+    assert not out.exists() and not list(tmp_path.iterdir())
+
+
+def test_bad_toml(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[discretization\nkind = 'cut'\n")
+    r = run("run", bad, "--out", tmp_path / "never")
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+    assert "bad.toml: not valid TOML" in r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.toml"]
+
+
+# --------------------------------------------------------------------------- in-process
+def patch_dict():
+    return tomllib.loads((SCENES / "patch.toml").read_text())
+
+
+@pytest.mark.parametrize(
+    "override,message",
+    [
+        ("discretization.h=-1", "discretization.h: must be > 0, got -1"),
+        ("discretization.kind='fitted'", "discretization.extent: not used by kind = 'fitted'"),
+        ("bodies[1].shap=1", "bodies[1].shap: unknown key"),
+        ("bodies[0].shape.type='star'", "bodies[0].shape.type: must be one of"),
+        ("bodies[1].name='lower'", "bodies[1].name: duplicate body name"),
+        ("pairs=[{bodies=['lower','lower']}]", "pairs[0].bodies: must be two different"),
+        ("boundaries[0].side='middle'", "boundaries[0].side: must be one or more of"),
+        ("dirichlet[0].value='x + q'", "dirichlet[0].value: unknown name 'q'"),
+        ("dirichlet[0].value='__import__(1)'", "dirichlet[0].value: only sqrt"),
+        ("tractions=[{boundary='upper_top', value=[1]}]", "tractions[0].value: must be a vector"),
+        ("stages=[{kind='force', dirichlet='nope'}]", "stages[0].dirichlet: unknown Dirichlet"),
+        ("stages=[{kind='force', dirichlet='top', target=1.0}]", "stages[0].first_guess: missing"),
+        (
+            "stages=[{kind='force', dirichlet='top', component='x', target=1.0, first_guess=0.0}]",
+            "stages[0].component: must be the component",
+        ),
+        ("stages=[{kind='friction', mu=-1}]", "stages[0].mu: must be >= 0"),
+        ("solver.steps=0", "solver.steps: must be >= 1"),
+        ("outputs.reaction='nope'", "outputs.reaction: unknown boundary 'nope'"),
+        ("analytic.type='hertz'", "analytic.R: missing"),
+        ("checks[0].quantity='foo.bar'", "checks[0].quantity: must be a metrics path"),
+        ("checks[0].close_to=1.0", "checks[0].close_to: needs rtol or atol"),
+        (
+            "bodies[0].law={type='orthotropic', E1=1, E2=1, E3=1, nu12=0.9, nu13=0.9, nu23=0.9, "
+            "G12=0.4}",
+            "bodies[0].law: OrthotropicElastic",
+        ),
+    ],
+)
+def test_description_errors(override, message):
+    with pytest.raises(SpecError) as e:
+        load(patch_dict(), [override])
+    assert str(e.value).startswith(message), str(e.value)
+    assert "\n" not in str(e.value)
+
+
+def test_description_defaults():
+    spec = load(SCENES / "patch.toml")
+    assert spec["name"] == "patch" and spec["pairs"] == [["lower", "upper"]]
+    assert spec["stages"] == [{"kind": "ramp", "label": "load", "to": None, "steps": 1}]
+    assert spec["outputs"]["reaction"] == "lower_bottom"  # the first Dirichlet boundary
+    assert spec["dirichlet"][1] == {
+        "boundary": "upper_top",
+        "point": None,
+        "component": "y",
+        "value": -0.01,
+        "name": "top",
+    }
+    mindlin = load(SCENES / "mindlin.toml")  # extends hertz.toml
+    assert mindlin["name"] == "mindlin" and mindlin["discretization"]["h"] == 0.05
+    assert [s["kind"] for s in mindlin["stages"]] == ["force", "friction", "force"]
+    assert mindlin["analytic"]["R"] == 10.0 and mindlin["analytic"]["tangential_force"]
+
+
+def test_fitted_patch(tmp_path):
+    """The gmsh path of meshes.from_spec: the patch on structured body-fitted quadrilaterals
+    (the boxes meet at y = 0.5 on matching edges) reproduces the penalised pressure."""
+    from dolfinx_forms import run
+
+    spec = patch_dict()
+    spec["discretization"] = {
+        "kind": "fitted",
+        "h": 0.25,
+        "cell": "quadrilateral",
+        "structured": True,
+    }
+    spec["solver"]["band"] = 0.125  # h / 2, as patch.toml (a band of h / 4 is too thin here)
+    spec["bodies"][0]["shape"]["max"][1] = spec["bodies"][1]["shape"]["min"][1] = 0.5
+    result = run(spec, write=False, log=lambda *a: None)
+    assert result.passed, result.failures
+    m = result.metrics
+    assert m["discretization"] == "conforming"
+    assert m["results"]["contact_length"] == pytest.approx(1.0, abs=1e-12)
+
+
+@pytest.mark.mpi
+def test_patch_scene_two_ranks():
+    """The runner on 2 ranks (scene partitioned, contact points on rank 0, metrics gathered):
+    the cut patch test is still exact."""
+    from mpi4py import MPI
+
+    from dolfinx_forms import run
+
+    assert MPI.COMM_WORLD.size == 2, "run under mpirun -n 2"
+    result = run(SCENES / "patch.toml", write=False, log=lambda *a: None)
+    assert result.passed, result.failures
+    assert result.metrics["results"]["num_points"]["slip"] == 64
