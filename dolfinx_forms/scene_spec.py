@@ -12,7 +12,8 @@ tan, exp, log, abs):
       changes: its tables merged key by key, anything else replaced)
   [discretization]  kind = "cut" | "fitted", h (mesh size at the contact),
       cut:    extent (box of the background grid), fine [none: uniform grid] (box where the
-              spacing is h, widened to the multiples of h), growth [1.2], h_far [no cap]
+              spacing is h, widened to the multiples of h), growth [1.2], h_far [no cap];
+              uniform grids: cells [extent / h, rounded] = [n_x, n_y]
       fitted: cell ["triangle" | "quadrilateral"], degree [1], fine [the contact box], h_far
               [8 h], slope [0.25] (gmsh size growth per unit distance from `fine`),
               structured [false] (boxes without a window: transfinite grids of about h)
@@ -253,6 +254,15 @@ def _discretization(t):
         d["fine"] = t.box("fine", None)
         d["growth"] = t.number("growth", 1.2, lo=1)
         d["h_far"] = t.number("h_far", None, lo=0, lo_open=True)
+        cells = t.raw("cells", None)
+        if cells is not None:
+            if not isinstance(cells, list) or len(cells) != len(d["extent"][0]):
+                raise SpecError(t.path("cells"), f"must be [n_x, n_y], got {cells!r}")
+            cells = [_number(n, f"{t.path('cells')}[{i}]", lo=1, integer=True)
+                     for i, n in enumerate(cells)]  # fmt: skip
+            if d["fine"] is not None:
+                raise SpecError(t.path("cells"), "is for uniform grids (no `fine`)")
+        d["cells"] = cells
         if t.string("cell", "quadrilateral") != "quadrilateral":
             raise SpecError(t.path("cell"), "the cut grid is made of quadrilaterals")
         if t.integer("degree", 1) != 1:

@@ -5,17 +5,17 @@ Shapes give each body an exact signed distance (dolfinx_forms shapes) and a boun
 a body is shape ∩ window when it has a window.
 
 * cut: the background grid spans `extent`; spacing h on `fine` (widened to the multiples of
-  h, so that 0 is a line) growing by `growth` outside up to h_far, or a uniform grid of about
-  h without `fine`. Every window bound is a grid line (outside `fine` the grading bends to hit
-  it; inside it must be a multiple of h). A body's window defaults to its bounding box widened
-  to grid lines. The level set that cuts cells is the shape, except that a box's sides lying
-  on its window's sides are pushed out (those sides are grid lines: no cell is cut there).
+  h, so that 0 is a line) growing by `growth` outside up to h_far, or without `fine` a
+  uniform grid of about h (or of `cells` [n_x, n_y]). Every window bound is a grid line
+  (outside `fine` the grading bends to hit it; inside it must be a multiple of h). A body's
+  window defaults to its bounding box widened to grid lines. The level set that cuts cells
+  is the shape, except that a box's sides lying on its window's sides are pushed out (those
+  sides are grid lines: no cell is cut there).
 * fitted: each body is a gmsh OpenCASCADE surface (disk, ellipse, rectangle, polygon,
   intersected with its window), meshed with size h on `fine` (default: the contact box),
-  growing with `slope` per unit distance up to h_far (`structured`: boxes without a window are
-  transfinite grids instead); quadrilaterals by recombination (meshed at 2h, every cell
-  subdivided). Bodies are separate surfaces: coincident boundaries keep
-  distinct vertices.
+  growing with `slope` per unit distance up to h_far (`structured`: boxes without a window
+  are transfinite grids instead); quadrilaterals by recombination (meshed at 2h, every cell
+  subdivided). Bodies are separate surfaces: coincident boundaries keep distinct vertices.
 Boundaries: `side` = sides of the body's window (cut) or bounding box (fitted); `box` = the
 boundary facets inside the box (of `body` if given). Boundary tags 1, 2, ... in order.
 """
@@ -176,7 +176,8 @@ def _grid_lines(d, windows):
     for ax in range(2):
         a, b = ext[:, ax]
         if d["fine"] is None:
-            lines.append(np.linspace(a, b, max(1, round((b - a) / h)) + 1))
+            n = d["cells"][ax] if d["cells"] else max(1, round((b - a) / h))
+            lines.append(np.linspace(a, b, n + 1))
             continue
         req = sorted({w[k][ax] for w in windows for k in (0, 1) if a < w[k][ax] < b})
         f0, f1 = d["fine"][0][ax], d["fine"][1][ax]

@@ -90,6 +90,24 @@ def test_patch_scene(tmp_path):
     assert m["checks_passed"]
 
 
+def test_two_blocks_scene(tmp_path):
+    """Tractions given as expressions in x, y, friction switched on before the ramp, a uniform
+    grid of given cells: the stick zone of demos/two_blocks.py (checks in the scene)."""
+    out = tmp_path / "blocks"
+    r = run("run", SCENES / "two_blocks.toml", "--out", out)
+    assert r.returncode == 0, r.stderr
+    m = metrics(out)
+    assert m["checks_passed"] and [s["kind"] for s in m["stages"]] == ["friction", "ramp"]
+    assert m["stages"][1]["values"] == {
+        "clamp": 0.0,
+        "top_x": 0.0,
+        "top_y": -1.6e-3,
+        "left": 1.0,
+        "right": 1.0,
+    }
+    assert m["results"]["num_points"]["slip"] > 0 and m["results"]["num_points"]["stick"] > 0
+
+
 def test_failed_check(tmp_path):
     """A check that fails: exit 1 with the reason, the results (and the verdict) written."""
     out = tmp_path / "patch"
@@ -209,6 +227,19 @@ def test_fitted_patch(tmp_path):
     m = result.metrics
     assert m["discretization"] == "conforming"
     assert m["results"]["contact_length"] == pytest.approx(1.0, abs=1e-12)
+
+
+def test_per_dof_values():
+    """A Dirichlet value given as an expression in x, y is a value per dof; in a ramp's `to`
+    too. u_y = -0.01 written as an expression of x keeps the patch test exact."""
+    from dolfinx_forms import run
+
+    spec = patch_dict()
+    spec["dirichlet"][1]["value"] = "-0.02 + 0.0 * x"
+    spec["stages"] = [{"kind": "ramp", "to": {"top": "-0.01 * (1 + 0 * x)"}}]
+    result = run(spec, write=False, log=lambda *a: None)
+    assert result.passed, result.failures
+    assert result.metrics["stages"][0]["values"]["top"] == {"min": -0.01, "max": -0.01}
 
 
 @pytest.mark.mpi
