@@ -48,8 +48,9 @@ class BodyForce:
         return lam if self.scale is None else self.scale(lam)
 
     def form(self, v, measure):
-        x = ufl.SpatialCoordinate(v.ufl_function_space().mesh)
-        f = self.f(x) if callable(self.f) else self.f
+        f = self.f
+        if not isinstance(f, ufl.core.expr.Expr) and callable(f):  # UFL exprs are callable too
+            f = f(ufl.SpatialCoordinate(v.ufl_function_space().mesh))
         return ufl.inner(f, v) * measure(self.body)
 
 

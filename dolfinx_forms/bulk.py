@@ -65,6 +65,13 @@ class BulkForms:
             self.F_nl = fem.form(F_nl)
             self.J_nl = fem.form(ufl.derivative(F_nl, u, du))
             self.b_nl = fem.petsc.create_vector(self.F_nl)
+            # explicit zeros on the nonlinear bodies' cells: PETSc drops preallocated entries
+            # never set at the first final assembly, and the Jacobian is a copy of K's pattern
+            zero = fem.Constant(mesh, 0.0)
+            dxb = ufl.Measure("dx", domain=mesh, subdomain_data=scene.cell_tags,
+                              metadata={"quadrature_degree": 0})
+            tags = tuple(t for t, law in self.laws.items() if not law.linear)
+            self.a_fill = fem.form(zero * ufl.inner(du, v) * dxb(tags))
         # right-hand sides, assembled once: f(lam) = sum scale_k(lam) f_k
         self.rhs = []
         for t in tractions:
@@ -87,13 +94,10 @@ class BulkForms:
             self.f_vectors.append(b)
 
     def assemble_linear(self, K):
-        """Add the linear part into K (its pattern must hold the mesh couplings). The cells
-        of nonlinear bodies get explicit zeros: PETSc drops preallocated entries never set,
-        and the Jacobian is a copy of K's pattern."""
+        """Add the linear part into K (its pattern must hold the mesh couplings), and explicit
+        zeros on the cells of nonlinear bodies."""
         if self.nonlinear:
-            fem.petsc.assemble_matrix(K, self.J_nl)
-            K.assemble()
-            K.zeroEntries()
+            fem.petsc.assemble_matrix(K, self.a_fill)
         if self.a_lin is not None:
             fem.petsc.assemble_matrix(K, self.a_lin)
 

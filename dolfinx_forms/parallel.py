@@ -23,8 +23,12 @@ MAX_MESSAGE = 2000  # characters of the exception message kept on the line
 
 
 def program_name() -> str:
-    """The running program's name (basename of argv[0]; 'python3' for -c / interactive)."""
-    name = os.path.basename(sys.argv[0]) if sys.argv and sys.argv[0] else ""
+    """The running program's name: basename of argv[0], the package for `python3 -m pkg`,
+    'python3' for -c / interactive."""
+    arg0 = sys.argv[0] if sys.argv and sys.argv[0] else ""
+    name = os.path.basename(arg0)
+    if name == "__main__.py":
+        return os.path.basename(os.path.dirname(os.path.abspath(arg0))) or "python3"
     return name if name and name not in ("-c", "-m") else "python3"
 
 

@@ -10,6 +10,7 @@ reached (rank 0, through problem.log) and returns a :class:`StageRecord` for met
 
     ramp(problem, top_y, -0.01, steps=4)                    # a displacement ramp
     ramp(problem, [top_y, side], [-0.02, 1.0])              # and a traction's load factor
+    ramp(problem, top_x, lambda x: 1e-3 * x[0])             # a value per dof: f(coordinates)
     reach_force(problem, top_y, "block_bottom", 1, 430.0, first_guess=-0.1)  # P = 430
     friction_on(problem, 0.3)
     reach_force(problem, top_x, "cylinder_top", 0, 64.5, first_guess=5e-5, monotone=True)
@@ -21,7 +22,15 @@ import numpy as np
 
 from .solver import ContactSolverError
 
-__all__ = ["Path", "StageRecord", "current_value", "ramp", "reach_force", "friction_on"]
+__all__ = [
+    "Path",
+    "StageRecord",
+    "current_value",
+    "dof_coordinates",
+    "ramp",
+    "reach_force",
+    "friction_on",
+]
 
 
 @dataclass
@@ -68,6 +77,13 @@ def current_value(problem, load):
     return np.array(v, float) if np.ndim(v) else float(v)
 
 
+def dof_coordinates(problem, bc):
+    """Coordinates (n, 3) of the dofs that the Dirichlet condition `bc` prescribes, in the
+    order of its per-dof values."""
+    k = next(i for i, d in enumerate(problem.dirichlet) if d is bc)
+    return problem.V.tabulate_dof_coordinates()[problem.bc_dofs[k] // problem.bs]
+
+
 def _loads(problem):
     """Every load of the problem: Dirichlet conditions, then tractions and body forces."""
     return [*problem.dirichlet, *(load for load, _ in problem.bulk.rhs)]
@@ -97,6 +113,9 @@ def _move(problem, moves, steps, label):
     for load in _loads(problem):
         start = current_value(problem, load)
         target = moving.get(id(load), start)
+        if callable(target):  # a function of the coordinates x (3, n) of the condition's dofs
+            X = dof_coordinates(problem, load)
+            target = np.broadcast_to(target(X.T), (len(X),))
         target = np.asarray(target, float) if np.ndim(target) else float(target)
         setattr(load, _attr(load), Path(start, target))
     n0 = len(problem.steps)
@@ -116,7 +135,8 @@ def _as_moves(loads, targets):
 
 def ramp(problem, bc, target, steps=1, label="ramp", boundary=None, names=None):
     """Move one load (or a list of loads) from its current value to `target` (a float, a per-dof
-    array, or a list aligned with the loads) in `steps` equal load steps, the others held.
+    array, a function f(x) of the coordinates x (3, n) of a Dirichlet condition's dofs, or a
+    list of these aligned with the loads) in `steps` equal load steps, the others held.
     The reaction reported is the one at `boundary` (default: the boundary of the first moved
     Dirichlet condition on a named boundary; none if there is no such condition). names: the
     loads' names in the progress line and the record (default: `describe`).

@@ -31,14 +31,19 @@ LevelSet closing_levelset(const LevelSet& phi_i, const LevelSet& phi_j, double e
 /// contact region Omega_c.
 ///
 /// From the values of phi_i, phi_j and the closing psi (`closing_levelset`) at a point,
-///   r = min(max(-phi_i, -phi_j, psi), max(phi_i, phi_j)),
+///   r = min(psi, max(phi_i, phi_j))   unless exactly one of phi_i, phi_j is < 0,
+///   r = -min(phi_i, phi_j) > 0       inside exactly one body,
 /// which is negative exactly on
-///   Omega_c = {phi_i > 0 and phi_j > 0 and psi < 0} U {phi_i < 0 and phi_j < 0}:
-/// the "liquid bridge" outside both bodies but close to both, and the penetrated overlap.
-/// It is continuous, so Omega_c can be clipped by root finding. `contact_region` flags the
-/// nodes where r < 0; `contact_surface` clips Gamma_int where r changes sign.
+///   Omega_c = {phi_i >= 0 and phi_j >= 0 and psi < 0} U {phi_i < 0 and phi_j < 0}:
+/// the "liquid bridge" outside both bodies (boundaries included, so bodies that touch along a
+/// line keep it) but close to both, and the penetrated overlap. It is continuous on Gamma_int
+/// (phi_i = phi_j, where it is min(psi, phi_i)), so Gamma_c is clipped by root finding.
+/// `contact_region` flags the nodes where r < 0; `contact_surface` clips Gamma_int where r
+/// changes sign.
 inline double region_indicator(double phi_i, double phi_j, double psi) {
-  return std::min(std::max({-phi_i, -phi_j, psi}), std::max(phi_i, phi_j));
+  if ((phi_i < 0) != (phi_j < 0))
+    return -std::min(phi_i, phi_j);
+  return std::min(psi, std::max(phi_i, phi_j));
 }
 
 /// @brief Node flags of the contact region (eq 22) extended to overlaps:

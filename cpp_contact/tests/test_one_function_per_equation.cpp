@@ -112,12 +112,12 @@ TEST(CellContour, CutCellClippingUsesTheContour) {
 }
 
 TEST(ContactRegion, IndicatorIsTheSetOfEq22) {
-  // r < 0 exactly on {phi_i > 0, phi_j > 0, psi < 0} U {phi_i < 0, phi_j < 0}
+  // r < 0 exactly on {phi_i >= 0, phi_j >= 0, psi < 0} U {phi_i < 0, phi_j < 0}
   const double v[5] = {-1.0, -1e-300, 0.0, 1e-300, 2.0};
   for (double a : v)
     for (double b : v)
       for (double c : v) {
-        const bool in = (a > 0 and b > 0 and c < 0) or (a < 0 and b < 0);
+        const bool in = (a >= 0 and b >= 0 and c < 0) or (a < 0 and b < 0);
         EXPECT_EQ(region_indicator(a, b, c) < 0, in) << a << " " << b << " " << c;
       }
 }
@@ -151,6 +151,23 @@ TEST(ContactRegion, NodeFlagsAndGammaCUseTheIndicator) {
     const std::span<const double, 2> x(s.segments.data() + 2 * p, 2);
     const double mean = 0.5 * (a.eval(x) + b.eval(x));
     EXPECT_LE(region_indicator(mean, mean, psi.eval(x)), 1e-12);
+  }
+}
+
+TEST(ContactRegion, TouchingBodiesKeepTheirContactLine) {
+  // Two blocks touching along y = y0 (phi_i = phi_j = 0 on Gamma_int): the whole line is in
+  // the region, on a grid line as well as between grid lines
+  for (double y0 : {0.0, 0.013}) {
+    const StructuredGrid g = StructuredGrid::uniform({-0.5, -0.5}, {0.5, 0.5}, {40, 40});
+    const LevelSet a = levelset_from_shape(g, Box({-1, -1}, {1, y0}));
+    const LevelSet b = levelset_from_shape(g, Box({-1, y0}, {1, 1}));
+    const ContactSurface s = contact_surface(a, b, 0.05);
+    double length = 0;
+    for (double w : s.weights)
+      length += w;
+    EXPECT_NEAR(length, 1.0, 1e-12) << "y0 = " << y0;
+    for (std::size_t p = 0; p < s.points.size() / 2; ++p)
+      EXPECT_NEAR(s.points[2 * p + 1], y0, 1e-12);
   }
 }
 
