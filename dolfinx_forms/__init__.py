@@ -66,9 +66,9 @@ _setup()
 
 
 def __getattr__(name):
-    """`dolfinx_forms.run` (runner.py: run a scene description), imported on first use."""
+    """`dolfinx_forms.run` (app.py: run a scene description), imported on first use."""
     if name == "run":
-        from .runner import run
+        from .app import run
 
         return run
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

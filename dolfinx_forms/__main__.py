@@ -62,7 +62,7 @@ def main(argv=None):
                 )
             return 0
         from .newton import ContactSolverError
-        from .runner import run
+        from .app import run
 
         try:
             result = run(

@@ -370,13 +370,8 @@ def run(
     if write:
         check_output_path(out, force)
     if build_scene is None:
-        try:
-            from meshes.from_spec import build_scene
-        except ImportError as e:
-            raise ImportError(
-                "the scene builders (the `meshes` package of this repository) "
-                "must be importable: run from the repository root"
-            ) from e
+        raise ValueError("build_scene: pass a scene builder (e.g. meshes.from_spec.build_scene),"
+                         " or call dolfinx_forms.run, which passes it")
     kind = spec["discretization"]["kind"]
     metrics = new_metrics(spec["name"], DISCRETIZATION_NAMES[kind], spec)
     timer = PhaseTimer(metrics)
