@@ -32,7 +32,8 @@ deps:
 	fi
 
 build: deps
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=$(PYTHON)
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=$(PYTHON) \
+	  -DCONTACT_BUILD_TESTS=ON -DCONTACT_BUILD_BENCHMARKS=ON
 	cmake --build $(BUILD) -j $(JOBS)
 
 test: build

@@ -18,121 +18,115 @@ round-off for any cut height.
 """
 
 import sys
-from pathlib import Path
 
 import numpy as np
-from mpi4py import MPI
 
-from dolfinx_forms import analytic
-from dolfinx_forms.cli import (DemoParser, add_discretization, bounded,
-                               check_discretization, petsc_options)
-from dolfinx_forms.output import atomic_output, finish, gather_points, plot_tractions
-from dolfinx_forms.results import PhaseTimer, new_metrics
-from dolfinx_forms.solver import ContactProblem, ContactSolverError, solver_metrics
+from dolfinx_forms import cli, compare
+from dolfinx_forms.demo import run_case
+from dolfinx_forms.protocol import ramp
 from meshes.cut import patch_cut_scene
 from meshes.patch import patch_dirichlet, patch_scene
 
+# fmt: off
+OPTIONS = [  # option, kind, default[, help]
+    ("--interface", "(0, 1)", None,
+     "cut path: height of the interface, off the grid lines (default 0.5 + 0.3 h)"),
+    ("--h", "(0, 0.5]", 0.125, "mesh size (cells of the lower block: 1/h x 0.5/h)"),
+    ("--E", "(0, inf)", 1.0),
+    ("--nu", "(-1, 0.5)", 0.3),
+    ("--mu", "[0, inf)", 0.0),
+    ("--displacement", "(0, 0.1]", 0.01, "downward displacement of the top"),
+    ("--eps0", "(0, inf)", 1.0),
+    ("--upper-cells", int, None,
+     "cells across the upper block (default: as the lower; non-matching otherwise)"),
+    ("--degree", [1, 2], 1),
+    ("--triangles", bool, False),
+]
+# fmt: on
+
 
 def parse(argv):
-    p = DemoParser(prog="patch_test.py", description=__doc__.split("\n\n")[0])
-    p.add_out("results/patch_test")
-    add_discretization(p)
-    p.add_argument("--interface", type=bounded("--interface", 0, 1, lo_open=True, hi_open=True),
-                   default=None, help="cut path: height of the interface, off the grid lines "
-                                      "(default 0.5 + 0.3 h)")
-    p.add_argument("--h", type=bounded("--h", 0, 0.5, lo_open=True), default=0.125,
-                   help="mesh size (cells of the lower block: 1/h x 0.5/h)")
-    p.add_argument("--E", type=bounded("--E", 0, None, lo_open=True), default=1.0)
-    p.add_argument("--nu", type=bounded("--nu", -1, 0.5, lo_open=True, hi_open=True), default=0.3)
-    p.add_argument("--mu", type=bounded("--mu", 0, None), default=0.0)
-    p.add_argument("--displacement", type=bounded("--displacement", 0, 0.1, lo_open=True),
-                   default=0.01, help="downward displacement of the top")
-    p.add_argument("--eps0", type=bounded("--eps0", 0, None, lo_open=True), default=1.0)
-    p.add_argument("--upper-cells", type=int, default=None,
-                   help="cells across the upper block (default: as the lower; non-matching otherwise)")
-    p.add_argument("--degree", type=int, choices=[1, 2], default=1)
-    p.add_argument("--triangles", action="store_true")
-    p.add_argument("--petsc", action="append", default=[], metavar="KEY=VALUE")
+    p = cli.demo_parser("patch_test.py", __doc__, "results/patch_test", OPTIONS)
     a = p.parse_args(argv)
-    check_discretization(p, a)
     nx = round(1.0 / a.h)
-    if abs(nx * a.h - 1.0) > 1e-12 or nx % 1:
-        p.error(f"--h: must be 1/n for an integer n so that the interface lies on mesh lines, got {a.h}")
+    if abs(nx * a.h - 1.0) > 1e-12:
+        p.error(
+            f"--h: must be 1/n for an integer n so that the interface lies on mesh lines, "
+            f"got {a.h}"
+        )
     if a.upper_cells is not None and not 1 <= a.upper_cells <= 1000:
         p.error("--upper-cells: must be in [1, 1000]")
     if a.discretization == "conforming" and a.interface is not None:
         p.error("--interface: only for --discretization cut (the gmsh blocks meet at 0.5)")
     if a.discretization == "cut":
-        if a.interface is None:
-            a.interface = 0.5 + 0.3 * a.h
-        k = a.interface / a.h
-        if abs(k - round(k)) < 1e-9:
-            p.error(f"--interface: must not lie on a grid line (multiples of h = {a.h}), "
-                    f"got {a.interface}")
+        a.interface = 0.5 + 0.3 * a.h if a.interface is None else a.interface
+        if abs(a.interface / a.h - round(a.interface / a.h)) < 1e-9:
+            p.error(
+                f"--interface: must not lie on a grid line (multiples of h = {a.h}), "
+                f"got {a.interface}"
+            )
         if a.upper_cells is not None:
             p.error("--upper-cells: only for --discretization conforming")
-    a.petsc = petsc_options(p, a.petsc)
     return a
+
+
+def scene(run):
+    """Two blocks: a uniform grid cut by the interface, or gmsh blocks meeting at y = 0.5."""
+    p, nx = run.params, round(1.0 / run.params["h"])
+    run.metrics["mesh"]["h_contact"] = p["h"]
+    if p["discretization"] == "cut":
+        return patch_cut_scene(run.comm, n=nx, interface=p["interface"])
+    return patch_scene(
+        run.comm, nx=nx, ny=max(1, nx // 2), quads=not p["triangles"], nx_upper=p["upper_cells"]
+    )
+
+
+def problem(run):
+    """Bottom held vertically, one point of each block horizontally; the top moved down."""
+    bcs = patch_dirichlet(run.params["displacement"])
+    run.loads["top"] = bcs[1]  # upper_top, u_y
+    return run.contact_problem(bcs, band=0.5 * run.params["h"])
+
+
+def stages(run):
+    return [ramp(run.problem, run.loads["top"], -run.params["displacement"], label="patch")]
+
+
+def evaluate(run):
+    """Uniform pressure (against the penalised and the exact value) and zero shear."""
+    p, pts = run.params, run.pts
+    res, an, run.curves = compare.patch(
+        pts, p["E"], p["nu"], p["displacement"], 1.0, run.problem.eps_n
+    )
+    run.results.update(
+        reaction=run.reactions["upper_top"],
+        **res,
+        shear_max=float(np.max(np.abs(pts["p_t"]))),
+        contact_length=float(np.sum(pts["w"])),
+    )
+    run.analytic.update(an)
+    run.plot_kw = dict(title="patch test", xlabel="x", ylabel="traction")
+
+
+SUMMARY = (
+    "patch test: pressure {results[pressure_mean]:.10f} (penalised exact "
+    "{analytic[pressure_penalised]:.10f}, eps -> 0: {analytic[pressure]:.10f}), max deviation "
+    "{results[pressure_max_rel_deviation]:.2e}, max shear {results[shear_max]:.2e}"
+)
 
 
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
-    comm = MPI.COMM_WORLD
-    metrics = new_metrics("patch", args.discretization, vars(args))
-    timer = PhaseTimer(metrics)
-    nx = round(1.0 / args.h)
-    with timer.phase("mesh"):
-        if args.discretization == "cut":
-            scene = patch_cut_scene(comm, n=nx, interface=args.interface)
-        else:
-            scene = patch_scene(comm, nx=nx, ny=max(1, nx // 2), quads=not args.triangles,
-                                nx_upper=args.upper_cells)
-    d = args.displacement
-    problem = ContactProblem(
-        scene, {b.tag: (args.E, args.nu) for b in scene.bodies}, mu=args.mu, eps0=args.eps0,
-        band=0.5 * args.h, degree=args.degree, petsc_options=args.petsc, timer=timer,
-        ghost_penalty=args.ghost_penalty,
-        dirichlet=patch_dirichlet(d))
-    try:
-        problem.solve(1, label="patch")
-    except ContactSolverError as e:
-        sys.stderr.write(f"patch_test.py: {e}\n")
-        return 1
-    reaction = problem.reaction("upper_top")
-    pts = gather_points(problem)
-    metrics["mesh"].update(h_contact=args.h, num_cells=scene.mesh.topology.index_map(2).size_global,
-                           num_dofs=problem.num_dofs)
-    metrics["solver"] = solver_metrics(problem)
-    Ep = args.E / (1 - args.nu**2)
-    exact = analytic.patch_pressure(args.E, args.nu, d / 1.0)
-    penalised = Ep * d / (1.0 + Ep * problem.eps_n)
-    if comm.rank == 0:
-        p, w = pts["p_n"], pts["w"]
-        res = metrics["results"]
-        res.update(reaction=[float(v) for v in reaction], pressure_mean=float(np.sum(w * p) / np.sum(w)),
-                   pressure_max_rel_deviation=float(np.max(np.abs(p - penalised)) / penalised),
-                   pressure_rel_error_vs_exact=float(np.max(np.abs(p - exact)) / exact),
-                   shear_max=float(np.max(np.abs(pts["p_t"]))),
-                   contact_length=float(np.sum(w)),
-                   pressure_rel_l2_error=float(np.sqrt(np.sum(w * (p - penalised) ** 2) /
-                                                       np.sum(w * penalised**2))))
-        metrics["analytic"].update(pressure=exact, pressure_penalised=penalised)
-    timer.stop()
-
-    def plot(path):
-        xs = np.array([0.0, 1.0])
-        plot_tractions(path, pts, {"exact": (xs, [exact] * 2), "penalised": (xs, [penalised] * 2)},
-                       title="patch test", xlabel="x", ylabel="traction")
-
-    with atomic_output(args.out, comm, force=args.force) as folder:
-        finish(folder, metrics, problem, pts, plot=plot if comm.rank == 0 else None)
-    if comm.rank == 0:
-        r = metrics["results"]
-        print(f"patch test: pressure {r['pressure_mean']:.10f} (penalised exact {penalised:.10f}, "
-              f"eps -> 0: {exact:.10f}), max deviation {r['pressure_max_rel_deviation']:.2e}, "
-              f"max shear {r['shear_max']:.2e}")
-        print(f"results in {Path(args.out).resolve()}")
-    return 0
+    return run_case(
+        "patch",
+        vars(args),
+        scene,
+        problem,
+        stages,
+        evaluate,
+        reactions=["upper_top"],
+        summary=SUMMARY,
+    )
 
 
 if __name__ == "__main__":

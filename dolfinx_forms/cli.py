@@ -11,6 +11,7 @@ parsing (rules: folders.py), so a run never computes and then refuses its output
 import argparse
 import copy
 import math
+import re
 import sys
 
 from .folders import OutputFolderError, check_output_path
@@ -68,6 +69,10 @@ class DemoParser(argparse.ArgumentParser):
 
     def parse_args(self, args=None, namespace=None):
         a = super().parse_args(args, namespace)
+        if getattr(self, "_discretization", False):  # add_discretization
+            check_discretization(self, a)
+        if getattr(self, "_petsc_dest", None) is not None:  # add_petsc: KEY=VALUE -> dict
+            setattr(a, self._petsc_dest, petsc_options(self, getattr(a, self._petsc_dest)))
         if getattr(a, "verbose", False):
             set_verbose(True)
         if self._out_dest is not None:
@@ -107,8 +112,57 @@ def bounded(name, lo=None, hi=None, lo_open=False, hi_open=False):
     return convert
 
 
+def interval(option, text):
+    """A `bounded` float type from an interval: "(0, inf)", "[0, 1)", "(-1, 0.5)"."""
+    m = re.fullmatch(r"([\[(])\s*([^,\s]+)\s*,\s*([^\s\])]+)\s*([\])])", text)
+    if m is None:
+        raise ValueError(f"{option}: not an interval: {text!r}")
+    lo, hi = (
+        None if v in ("-inf", "inf") else (int(v) if v.lstrip("-").isdigit() else float(v))
+        for v in m.group(2, 3)
+    )
+    return bounded(option, lo, hi, lo_open=m[1] == "(", hi_open=m[4] == ")")
+
+
+def add_options(parser, rows):
+    """Options from a table of rows (option, kind, default[, help]); kind: an interval of
+    floats ("(0, inf)", "[0, 1)": checked, see `bounded`), a `range` of integers (shown as
+    [lo..hi]), a list of choices, bool (a flag, default False), or int, float, str
+    (unchecked). Without help, --help shows the default."""
+    for option, kind, default, *help in rows:
+        kw = dict(default=default, help=help[0] if help else None)
+        if isinstance(kind, str):
+            kw["type"] = interval(option, kind)
+        elif isinstance(kind, range):
+            kw.update(type=int, choices=kind, metavar=f"[{kind[0]}..{kind[-1]}]")
+        elif isinstance(kind, list):
+            kw.update(type=type(kind[0]), choices=kind)
+        elif kind is bool:
+            kw["action"] = "store_true"
+        elif kind in (int, float, str):
+            kw["type"] = kind
+        else:
+            raise TypeError(f"{option}: unknown kind {kind!r}")
+        parser.add_argument(option, **kw)
+
+
+def add_petsc(parser):
+    """--petsc KEY=VALUE (repeatable), parsed into a dict by parse_args (petsc_options)."""
+    parser.add_argument(
+        "--petsc",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="PETSc option for the linear solver (prefix ils_), repeatable",
+    )
+    parser._petsc_dest = "petsc"
+
+
 def petsc_options(parser, items):
-    """Parse repeated --petsc KEY=VALUE into a dict (keys without the leading dash)."""
+    """Parse repeated --petsc KEY=VALUE into a dict (keys without the leading dash); a dict
+    (already parsed, see add_petsc) is returned as it is."""
+    if isinstance(items, dict):
+        return items
     opts = {}
     for item in items:
         key, sep, value = item.partition("=")
@@ -119,8 +173,24 @@ def petsc_options(parser, items):
     return opts
 
 
+def demo_parser(prog, doc, out, options=(), discretization=True, petsc=True):
+    """A demo's parser: the description is the first paragraph of `doc`; --out (default `out`)
+    and --force, --discretization and --ghost-penalty (add_discretization), the `options`
+    table (add_options), --petsc (add_petsc)."""
+    p = DemoParser(prog=prog, description=doc.split("\n\n")[0])
+    p.add_out(out)
+    if discretization:
+        add_discretization(p)
+    add_options(p, options)
+    if petsc:
+        add_petsc(p)
+    return p
+
+
 def add_discretization(parser):
-    """--discretization and the cut path's --ghost-penalty (shared by every demo)."""
+    """--discretization and the cut path's --ghost-penalty (shared by every demo), checked by
+    DemoParser.parse_args (check_discretization)."""
+    parser._discretization = True
     parser.add_argument(
         "--discretization",
         choices=["conforming", "cut"],

@@ -12,15 +12,16 @@ A demo states the physics (its scene and problem), the protocol (its stages) and
 A solver failure (ContactSolverError) in the stages prints one line on stderr (rank 0),
 writes nothing and gives exit status 1. Every callback receives the :class:`Run`:
 
-    def scene(run):      return hertz_scene(run.comm, ...)         # timed as "mesh"
-    def problem(run):    run.loads["top_y"] = ...; return ContactProblem(run.scene, ...,
-                                                                         timer=run.timer)
-    def stages(run):     return [protocol.ramp(run.problem, run.loads["top_y"], -0.01)]
+    def scene(run):      return patch_cut_scene(run.comm, n=8)          # timed as "mesh"
+    def problem(run):    run.loads["top"] = Dirichlet("upper_top", 1, 0.0)
+                         return run.contact_problem([..., run.loads["top"]], band=0.05)
+    def stages(run):     return [protocol.ramp(run.problem, run.loads["top"], -0.01)]
     def evaluate(run):   run.results.update(...); run.analytic.update(...); run.curves = {...}
-    def summary(run):    return f"patch test: pressure {run.results['pressure_mean']:.6g}"
+    summary = "patch test: pressure {results[pressure_mean]:.6g}"  # or a function of run
 
-    sys.exit(run_case("patch", "cut", vars(args), scene, problem, stages, evaluate,
-                      reactions=["upper_top"], summary=summary, out=args.out, force=args.force))
+    params = dict(vars(args), derived=...)   # metrics.json "parameters"; out, force from it
+    sys.exit(run_case("patch", params, scene, problem, stages, evaluate,
+                      reactions=["upper_top"], summary=summary))
 
 The parts `compute` (everything up to the timer stop; raises ContactSolverError) and `write`
 (the atomic folder) are what runner.run uses.
@@ -71,6 +72,28 @@ class Run:
     def rank0(self):
         return self.comm.rank == 0
 
+    def contact_problem(self, dirichlet=(), **kw):
+        """A ContactProblem on the scene, timed by the run's timer, with the options that the
+        parameters name: E, nu (every body linear elastic), mu, eps0, degree, ghost_penalty,
+        grid_refine, gauss (num_gauss), petsc (petsc_options). Keywords override them."""
+        from .solver import ContactProblem
+
+        p, opts = self.params, {"timer": self.timer, "dirichlet": dirichlet}
+        if "E" in p:
+            opts["materials"] = {b.tag: (p["E"], p["nu"]) for b in self.scene.bodies}
+        names = dict(
+            mu="mu",
+            eps0="eps0",
+            degree="degree",
+            ghost_penalty="ghost_penalty",
+            grid_refine="grid_refine",
+            gauss="num_gauss",
+            petsc="petsc_options",
+        )
+        opts.update({names[k]: p[k] for k in names if k in p})
+        opts.update(kw)
+        return ContactProblem(self.scene, opts.pop("materials"), **opts)
+
 
 def traction_plot(run, path):
     """The default plot: computed tractions against `run.curves` (output.plot_tractions)."""
@@ -81,13 +104,13 @@ def traction_plot(run, path):
 
 def compute(
     name,
-    discretization,
     params,
     build_scene,
     build_problem=None,
     stages=None,
     evaluate=None,
     *,
+    discretization=None,
     reactions=(),
     collect=None,
     comm=None,
@@ -95,6 +118,7 @@ def compute(
     """Scene, problem, stages, reactions at `reactions` (boundary names), contact points,
     mesh and solver blocks, collect(run) on every rank, evaluate(run) on rank 0, timer stop;
     the metrics are then broadcast to every rank. Returns the Run. Raises ContactSolverError.
+    discretization: metrics.json's (default params["discretization"], else "conforming").
 
     build_scene may set metrics["mesh"]["h_contact"] (default: scene.h_contact).
     Without build_problem (a geometry demo) the stages still run (stages(run), timed by the
@@ -105,6 +129,7 @@ def compute(
     from .solver import solver_metrics
 
     comm = MPI.COMM_WORLD if comm is None else comm
+    discretization = discretization or params.get("discretization", "conforming")
     metrics = new_metrics(name, discretization, params)
     run = Run(name, discretization, comm, metrics, PhaseTimer(metrics))
     with run.timer.phase("mesh"):
@@ -168,15 +193,15 @@ def write(
 
 def run_case(
     name,
-    discretization,
     params,
     build_scene,
     build_problem=None,
     stages=None,
     evaluate=None,
     *,
-    out,
-    force=False,
+    discretization=None,
+    out=None,
+    force=None,
     reactions=(),
     collect=None,
     plot=traction_plot,
@@ -185,19 +210,24 @@ def run_case(
     comm=None,
     prog=None,
 ):
-    """One demo run (module doc): `compute`, then `write` into `out`, then summary(run) (a
-    string, printed on rank 0) and "results in ...". Returns the exit status: 0, or 1 after a
-    ContactSolverError (one line "prog: message" on stderr, nothing written)."""
+    """One demo run (module doc): `compute`, then `write` into `out` (default params["out"],
+    force: params["force"]), then the summary (printed on rank 0: summary(run), or a format
+    string filled with the metrics, "{results[peak_pressure]:.5g}") and "results in
+    ...". Returns the exit status: 0, or 1 after a ContactSolverError (one line "prog: message"
+    on stderr, nothing written). params: every input after defaults (metrics.json's
+    "parameters"), usually dict(vars(args), derived values...)."""
     prog = prog or Path(sys.argv[0]).name
+    out = params["out"] if out is None else out
+    force = params.get("force", False) if force is None else force
     try:
         run = compute(
             name,
-            discretization,
             params,
             build_scene,
             build_problem,
             stages,
             evaluate,
+            discretization=discretization,
             reactions=reactions,
             collect=collect,
             comm=comm,
@@ -211,6 +241,6 @@ def run_case(
     folder = write(run, out, force, plot=plot, files=files)
     if run.rank0:
         if summary is not None:
-            print(summary(run))
+            print(summary(run) if callable(summary) else summary.format(**run.metrics))
         print(f"results in {folder}")
     return 0

@@ -35,6 +35,12 @@ def write_tractions(folder, pts):
                         f"{pts['slip'][k]:.12e}", STATE_NAMES[int(pts["state"][k])]])
 
 
+def write_columns(path, **columns):
+    """A CSV file of equally long columns {name: values}: a header line, then %.12e values."""
+    np.savetxt(path, np.column_stack(list(columns.values())), delimiter=",", fmt="%.12e",
+               header=",".join(columns), comments="")
+
+
 def write_fields(folder, problem, name="solution"):
     """Displacement (P1) and Cauchy stress (cellwise constant) in XDMF for ParaView."""
     from dolfinx import fem, io
@@ -63,6 +69,29 @@ def plot_tractions(path, pts, analytic=None, title="", xlabel="x (mm)", ylabel="
         ax.plot(pts["x"], pts["p_t"], ".", ms=3, label="p_t computed")
     for label, (x, y) in (analytic or {}).items():
         ax.plot(x, y, "-", lw=1, label=label)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def plot_lines(path, lines, title="", xlabel="x (mm)", ylabel="", vlines=()):
+    """Curves {label: (x, y, style)} (style "-": a line, ".": points) and dotted vertical lines
+    at the abscissae `vlines`, in one PNG."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for label, (x, y, style) in lines.items():
+        ax.plot(x, y, style, label=label, **(dict(ms=3) if style == "." else dict(lw=1)))
+    for xv in vlines:
+        ax.axvline(xv, color="0.6", lw=0.8, ls=":")
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(title)

@@ -11,7 +11,8 @@ compares with the analytic reference if one is named ([analytic]), evaluates the
 and writes metrics.json (the results contract, plus `stages` and `checks`), tractions.csv,
 tractions.png and solution.xdmf into one atomic folder. A failed check is reported, recorded
 and makes `passed` False (the command line exits with 1); a solver failure raises
-ContactSolverError and writes nothing.
+ContactSolverError and writes nothing. The run skeleton is the demos' (demo.compute and
+demo.write), the measures and analytic comparisons theirs too (compare.py).
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from . import analytic, protocol
+from . import analytic, compare, protocol
+from .compare import contact_results  # noqa: F401 (its former home)
 from .scene_spec import FUNCTIONS, SpecError, load, make_law
 
 __all__ = ["run", "RunResult", "contact_results", "evaluate_checks"]
@@ -189,91 +191,30 @@ def run_stages(problem, spec, loads, targets):
 
 
 # --------------------------------------------------------------------------- results
-def contact_results(pts, mu):
-    """Measures of the contact points (gather_points): reaction-free, any scene. The zone
-    ends are along x (zone_ends): half-widths suit interfaces that run along x."""
-    from .solver import zone_ends
-
-    x, p, q, w, gap, slip, state = (
-        pts[k] for k in ("x", "p_n", "p_t", "w", "gap_n", "slip", "state")
-    )
-    active = state != 0
-    res = {
-        "num_points": {n: int(np.sum(state == k)) for k, n in enumerate(("open", "stick", "slip"))},
-        "contact_force": float(np.sum(w * p)),
-        "tangential_force": float(np.sum(w * q)),
-        "contact_length": float(np.sum(w[active])),
-        "peak_pressure": float(p.max()) if p.size else None,
-        "shear_max": float(np.abs(q).max()) if q.size else None,
-        "max_penetration": float(max(0.0, -gap[active].min())) if active.any() else None,
-    }
-    xl, xr = zone_ends(x, active, gap)
-    res["contact_half_width"] = None if xl is None else float(0.5 * (xr - xl))
-    res["contact_centre"] = None if xl is None else float(0.5 * (xr + xl))
-    if mu > 0:  # stick zone: active points that never slipped since friction was switched on
-        slipped = np.abs(slip) > 1e-9 * max(np.abs(slip).max(initial=0.0), 1e-300)
-        sl, sr = zone_ends(x, active & ~slipped)
-        res["stick_half_width"] = None if sl is None else float(0.5 * (sr - sl))
-    return res
-
-
-def _rel_l2(w, a, b):
-    den = np.sum(w * b**2)
-    return float(np.sqrt(np.sum(w * (a - b) ** 2) / den)) if den > 0 else None
-
-
 def _hertz(ref, spec, pts, reactions, problem):
     """Hertz (and Cattaneo-Mindlin with a tangential force) at the computed loads."""
     laws = {b["name"]: b["law"] for b in spec["bodies"]}
     (l1, l2) = (laws[n] for n in ref["bodies"])
     E_star = analytic.effective_modulus(l1["E"], l1["nu"], l2["E"], l2["nu"])
-    nf = ref["normal_force"]
+    nf, tf = ref["normal_force"], ref["tangential_force"]
     P = abs(reactions[nf["boundary"]]["xyz".index(nf["component"])])
     if P == 0:  # no load reached the contact: nothing to compare
         return {}, {}, {}
-    a, p0 = analytic.hertz_line(P, ref["R"], E_star)
-    x, w = pts["x"], pts["w"]
-    res = {"pressure_rel_l2_error": _rel_l2(w, pts["p_n"], analytic.hertz_pressure(x, a, p0))}
-    an = {"contact_half_width": float(a), "peak_pressure": float(p0), "load": float(P)}
-    tf, mu = ref["tangential_force"], problem.mu
-    if tf is not None and mu > 0:
+    Q = None
+    if tf is not None and problem.mu > 0:
         Q = abs(reactions[tf["boundary"]]["xyz".index(tf["component"])])
-        res["tangential_ratio"] = float(Q / (mu * P))
+    res, an, curves = compare.hertz(pts, P, ref["R"], E_star, problem.mu, Q)
+    an["load"] = float(P)
+    if Q is not None:
         an["tangential_force"] = float(Q)
-        if Q < mu * P:  # partial slip: Cattaneo-Mindlin
-            c = float(analytic.mindlin_stick_half_width(a, Q, mu, P))
-            qa = analytic.mindlin_shear(x, a, c, p0, mu)
-            res["traction_rel_l2_error"] = _rel_l2(w, np.abs(pts["p_t"]), qa)
-            an["stick_half_width"] = c
-    xs = np.linspace(-1.5 * a, 1.5 * a, 400)
-    plot = {"Hertz p(x)": (xs, analytic.hertz_pressure(xs, a, p0))}
-    if "stick_half_width" in an:
-        sign = np.sign(np.sum(pts["p_t"])) or 1.0
-        plot["Cattaneo-Mindlin q(x)"] = (
-            xs,
-            sign * analytic.mindlin_shear(xs, a, an["stick_half_width"], p0, mu),
-        )
-    return res, an, plot
+    return res, an, curves
 
 
 def _patch(ref, spec, pts, reactions, problem):
     """Uniform pressure of the frictionless patch test, exact and penalised (eq 51)."""
     law = next(b["law"] for b in spec["bodies"] if b["name"] == ref["body"])
-    Ep, d, H = law["E"] / (1 - law["nu"] ** 2), ref["displacement"], ref["height"]
-    exact = float(analytic.patch_pressure(law["E"], law["nu"], d / H))
-    penalised = float(Ep * d / (H + Ep * problem.eps_n))
-    an = {"pressure": exact, "pressure_penalised": penalised}
-    p, w = pts["p_n"], pts["w"]
-    if not p.size:  # no contact point: nothing to compare (the checks fail with a reason)
-        return {}, an, {}
-    res = {
-        "pressure_mean": float(np.sum(w * p) / np.sum(w)),
-        "pressure_max_rel_deviation": float(np.max(np.abs(p - penalised)) / penalised),
-        "pressure_rel_error_vs_exact": float(np.max(np.abs(p - exact)) / exact),
-        "pressure_rel_l2_error": _rel_l2(w, p, np.full_like(p, penalised)),
-    }
-    xs = np.array([pts["x"].min(), pts["x"].max()])
-    return res, an, {"exact": (xs, [exact] * 2), "penalised": (xs, [penalised] * 2)}
+    d, H = ref["displacement"], ref["height"]
+    return compare.patch(pts, law["E"], law["nu"], d, H, problem.eps_n)
 
 
 REFERENCES = {"hertz": _hertz, "patch": _patch}
@@ -359,10 +300,9 @@ def run(
     (default results/<name>); write=False computes without writing. build_scene(comm, spec)
     -> Scene replaces meshes.from_spec.build_scene. Raises SpecError (bad description),
     OutputFolderError (refused --out) before computing, ContactSolverError (solver failure)."""
-    from .folders import atomic_output_dir, check_output_path
-    from .output import gather_points, plot_tractions, write_fields, write_tractions
-    from .results import PhaseTimer, new_metrics, write_metrics
-    from .solver import solver_metrics
+    from .demo import compute, traction_plot
+    from .demo import write as write_folder
+    from .folders import check_output_path
 
     spec = load(source, overrides)
     comm = MPI.COMM_WORLD if comm is None else comm
@@ -370,67 +310,73 @@ def run(
     if write:
         check_output_path(out, force)
     if build_scene is None:
-        raise ValueError("build_scene: pass a scene builder (e.g. meshes.from_spec.build_scene),"
-                         " or call dolfinx_forms.run, which passes it")
-    kind = spec["discretization"]["kind"]
-    metrics = new_metrics(spec["name"], DISCRETIZATION_NAMES[kind], spec)
-    timer = PhaseTimer(metrics)
-    with timer.phase("mesh"):
-        scene = build_scene(comm, spec)
-    _check_scene(scene, spec)
-    problem, loads, targets = build_problem(spec, scene, timer, log)
-    records = run_stages(problem, spec, loads, targets)
+        raise ValueError(
+            "build_scene: pass a scene builder (e.g. meshes.from_spec.build_scene),"
+            " or call dolfinx_forms.run, which passes it"
+        )
 
-    reactions = {b: [float(f) for f in problem.reaction(b)] for b in _reaction_boundaries(spec)}
-    pts = gather_points(problem)
-    metrics["mesh"].update(
-        h_contact=scene.h_contact,
-        num_dofs=problem.num_dofs,
-        num_cells=scene.mesh.topology.index_map(scene.mesh.topology.dim).size_global,
-    )
-    metrics["solver"] = solver_metrics(problem)
-    metrics["stages"] = [r.as_dict() for r in records]
-    plot = {}
-    if comm.rank == 0:
-        res = metrics["results"]
-        res.update(contact_results(pts, problem.mu))
-        res["reaction"] = reactions.get(spec["outputs"]["reaction"])
-        res["reactions"] = reactions
+    def problem(r):
+        _check_scene(r.scene, spec)
+        pb, r.loads, r.data["targets"] = build_problem(spec, r.scene, r.timer, log)
+        return pb
+
+    def stages(r):
+        return run_stages(r.problem, spec, r.loads, r.data["targets"])
+
+    def collect(r):  # every rank: the checks may name the stages' records
+        r.metrics["stages"] = [rec.as_dict() for rec in r.records]
+
+    def evaluate(r):
+        res = r.results
+        res.update(compare.contact_results(r.pts, r.problem.mu))
+        res["reaction"] = r.reactions.get(spec["outputs"]["reaction"])
+        res["reactions"] = r.reactions
         if spec["analytic"] is not None:
-            r, an, plot = REFERENCES[spec["analytic"]["type"]](
-                spec["analytic"], spec, pts, reactions, problem
-            )
-            res.update(r)
-            metrics["analytic"].update(an)
-        metrics["checks"] = evaluate_checks(metrics, spec["checks"])
-        metrics["checks_passed"] = all(c["passed"] for c in metrics["checks"])
-        for c in metrics["checks"]:
+            ref = REFERENCES[spec["analytic"]["type"]]
+            found, an, r.curves = ref(spec["analytic"], spec, r.pts, r.reactions, r.problem)
+            res.update(found)
+            r.analytic.update(an)
+        r.metrics["checks"] = evaluate_checks(r.metrics, spec["checks"])
+        r.metrics["checks_passed"] = all(c["passed"] for c in r.metrics["checks"])
+        for c in r.metrics["checks"]:
             log(
                 f"check {c['label']}: {'ok' if c['passed'] else 'FAILED'} "
                 f"({c['reason'] or c['criterion']})"
             )
-    timer.stop()
-    metrics = comm.bcast(metrics if comm.rank == 0 else None, root=0)
+        r.plot_kw = dict(title=f"{spec['name']}, h = {r.scene.h_contact:.3g}")
+
+    r = compute(
+        spec["name"],
+        spec,
+        lambda r: build_scene(comm, spec),
+        problem,
+        stages,
+        evaluate,
+        discretization=DISCRETIZATION_NAMES[spec["discretization"]["kind"]],
+        reactions=_reaction_boundaries(spec),
+        collect=collect,
+        comm=comm,
+    )
+    metrics = r.metrics
     failures = [
         f"check {c['label']!r} failed: {c['reason']}" for c in metrics["checks"] if not c["passed"]
     ]
-    result = RunResult(metrics, not failures, failures, None, problem)
+    result = RunResult(metrics, not failures, failures, None, r.problem)
     if not write:
         return result
     o = spec["outputs"]
-    with atomic_output_dir(out, comm, force=force, program="dolfinx_forms run") as folder:
-        if o["solution"]:
-            write_fields(folder, problem)
-        if comm.rank == 0:
-            if o["tractions"]:
-                write_tractions(folder, pts)
-            if o["plot"] and len(pts["x"]):
-                plot_tractions(
-                    Path(folder) / "tractions.png",
-                    pts,
-                    plot,
-                    title=f"{spec['name']}, h = {scene.h_contact:.3g}",
-                )
-            write_metrics(folder, metrics)
-    result.folder = out.resolve()
+
+    def plot(r, path):
+        if len(r.pts["x"]):
+            traction_plot(r, path)
+
+    result.folder = write_folder(
+        r,
+        out,
+        force,
+        plot=plot if o["plot"] else None,
+        solution=o["solution"],
+        tractions=o["tractions"],
+        program="dolfinx_forms run",
+    )
     return result

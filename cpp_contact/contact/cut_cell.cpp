@@ -39,12 +39,6 @@ double area(const double* t) {
   return 0.5 * ((t[2] - t[0]) * (t[5] - t[1]) - (t[4] - t[0]) * (t[3] - t[1]));
 }
 
-/// Q1 reference gradients at (X, Y), tensor order.
-void q1_gradients(double X, double Y, double dX[4], double dY[4]) {
-  dX[0] = -(1 - Y), dX[1] = 1 - Y, dX[2] = -Y, dX[3] = Y;
-  dY[0] = -(1 - X), dY[1] = -X, dY[2] = 1 - X, dY[3] = X;
-}
-
 /// Facet -> its two vertices (DOLFINx quadrilateral).
 constexpr std::array<std::array<int, 2>, 4> facet_vertices = {{{0, 1}, {0, 2}, {1, 3}, {2, 3}}};
 
@@ -257,39 +251,6 @@ void moment_fitted_weights(std::span<const double, 4> phi, std::span<const doubl
   }
   for (std::size_t k = 0; k < nq; ++k)
     weights[k] = M[pos[0][k] * m[1] + pos[1][k]];
-}
-
-void elasticity_q1(double* A, const double* w, const double*, const double* x, const int*,
-                   const std::uint8_t*) {
-  const std::span<const double, 4> phi(w + Layout::phi, 4);
-  const double mu = w[Layout::lame], lambda = w[Layout::lame + 1];
-  thread_local std::vector<double> pts, wts;
-  pts.clear(), wts.clear();
-  cut_square_rule(phi, 2, pts, wts); // Q1 stiffness on a parallelogram is quadratic
-  for (std::size_t q = 0; q < wts.size(); ++q) {
-    double dX[4], dY[4];
-    q1_gradients(pts[2 * q], pts[2 * q + 1], dX, dY);
-    double J[2][2] = {{0, 0}, {0, 0}};
-    for (int n = 0; n < 4; ++n) {
-      J[0][0] += x[3 * n] * dX[n], J[0][1] += x[3 * n] * dY[n];
-      J[1][0] += x[3 * n + 1] * dX[n], J[1][1] += x[3 * n + 1] * dY[n];
-    }
-    const double det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
-    double g[4][2]; // physical gradients: J^{-T} (dX, dY)
-    for (int n = 0; n < 4; ++n) {
-      g[n][0] = (J[1][1] * dX[n] - J[1][0] * dY[n]) / det;
-      g[n][1] = (-J[0][1] * dX[n] + J[0][0] * dY[n]) / det;
-    }
-    const double s = wts[q] * std::abs(det);
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) {
-        const double dot = g[a][0] * g[b][0] + g[a][1] * g[b][1];
-        for (int i = 0; i < 2; ++i)
-          for (int k = 0; k < 2; ++k)
-            A[(2 * a + i) * 8 + 2 * b + k] +=
-                s * (mu * ((i == k) * dot + g[a][k] * g[b][i]) + lambda * g[a][i] * g[b][k]);
-      }
-  }
 }
 
 void traction_q1(double* A, const double* w, const double*, const double* x,

@@ -1,9 +1,10 @@
 // Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
 #pragma once
 
-// Cut-cell geometry and quadrature on the reference square, and the element kernels of the
-// cut path (section 4.2). Pure numerics: no DOLFINx here; the kernels only follow the
-// ufcx tabulate_tensor ABI so that DOLFINx can call them as custom integrals.
+// Cut-cell geometry and quadrature on the reference square (section 4.2): clipping, rules,
+// moment-fitted weights for FFCx's Gauss points, and the clipped traction kernel. Pure numerics: no
+// DOLFINx here; the kernels only follow the ufcx tabulate_tensor ABI so that DOLFINx can call them
+// as custom integrals.
 //
 // Conventions (DOLFINx quadrilateral): reference square [0,1]^2, vertices in tensor order
 // v0 (0,0), v1 (1,0), v2 (0,1), v3 (1,1); facets f0 (v0,v1), f1 (v0,v2), f2 (v1,v3),
@@ -25,13 +26,12 @@ namespace contact::cut {
 constexpr int max_triangles = 4;
 
 /// Layout of the packed coefficients `w` that the cut kernels read (one source of truth: the
-/// Python forms are built to match it and check it). Bilinear form: w = [phi(4), mu, lambda];
-/// traction form: w = [phi(4), t(18)] with t a vector Q2 function (9 nodes x 2, interleaved).
+/// Python forms are built to match it and check it). Traction form: w = [phi(4), t(18)] with t
+/// a vector Q2 function (9 nodes x 2, interleaved). Cell integrals of any UFL form on cut cells
+/// do not need a kernel: FFCx's rule with `moment_fitted_weights` (dolfinx_forms/cut.py).
 struct Layout {
   static constexpr int phi = 0;      ///< offset of the 4 vertex values of phi
-  static constexpr int lame = 4;     ///< offset of (mu, lambda), a DG0 vector (bilinear form)
   static constexpr int traction = 4; ///< offset of the Q2 vector traction (linear form)
-  static constexpr int bilinear_size = 6;
   static constexpr int traction_size = 22;
 };
 
@@ -78,14 +78,6 @@ constexpr int max_fitted_points = 6;
 /// @throws std::invalid_argument if the points are not a full tensor grid or sizes mismatch
 void moment_fitted_weights(std::span<const double, 4> phi, std::span<const double> points,
                            std::span<double> weights);
-
-/// @brief Cut-cell plane-strain elasticity matrix of a vector Q1 quadrilateral (ufcx ABI).
-///
-/// A (8x8, row-major, dof = node*2 + component) += int_{cell, phi_h<0} 2 mu eps(u):eps(v) +
-/// lambda div u div v, with a degree-2 rule on each sub-triangle (exact on parallelograms).
-/// w: see `Layout` (phi at the vertices, then mu, lambda). coordinate_dofs: 4 nodes x 3.
-void elasticity_q1(double* A, const double* w, const double* c, const double* coordinate_dofs,
-                   const int* entity_local_index, const std::uint8_t* quad_perm);
 
 /// @brief Traction load on the inside part of a boundary facet of a cut cell (ufcx ABI).
 ///

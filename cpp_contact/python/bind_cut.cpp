@@ -20,7 +20,6 @@ void bind_cut(py::module_& m) {
       "cut_kernels",
       []() {
         py::dict d;
-        d["elasticity_q1"] = reinterpret_cast<std::uintptr_t>(&cut::elasticity_q1);
         d["traction_q1"] = reinterpret_cast<std::uintptr_t>(&cut::traction_q1);
         return d;
       },
@@ -30,9 +29,7 @@ void bind_cut(py::module_& m) {
       []() {
         py::dict d;
         d["phi"] = cut::Layout::phi;
-        d["lame"] = cut::Layout::lame;
         d["traction"] = cut::Layout::traction;
-        d["bilinear_size"] = cut::Layout::bilinear_size;
         d["traction_size"] = cut::Layout::traction_size;
         return d;
       },

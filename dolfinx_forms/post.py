@@ -1,7 +1,9 @@
-"""Point values of the solution: a stress component of one body along a line of points.
+"""Post-processing of a solved problem: a stress component along a line of points, and the
+contact, stick and slip zones of an interface that runs along x.
 
     xs = np.linspace(0.0, 40.0, 161)
     sx = stress_at_points(problem, np.column_stack([xs, np.full_like(xs, 5.0)]))  # sigma_xx
+    metrics["results"].update(contact_zones(gather_points(problem)))  # on rank 0
 
 The stress is the laws' own output stress (`problem.stress`), interpolated cellwise (DG/DQ 1)
 and averaged at the vertices into a continuous P1/Q1 field: a line along mesh edges (a grid
@@ -13,7 +15,7 @@ and on a cut scene their cells overlap along the interface.
 
 import numpy as np
 
-__all__ = ["stress_at_points"]
+__all__ = ["stress_at_points", "contact_zones"]
 
 
 def stress_at_points(problem, points, component=(0, 0), body=0):
@@ -61,3 +63,44 @@ def stress_at_points(problem, points, component=(0, 0), body=0):
     for a in allv:  # the first rank that owns a cell holding the point
         v = np.where(np.isnan(v), a, v)
     return v
+
+
+def contact_zones(pts):
+    """Zones of the contact points along x (output.gather_points: sorted by x), None where a
+    zone is empty: contact_zone [x_l, x_r] of the active points (ends at the zero of the gap)
+    and its half-width, peak pressure, contact force (sum w p_n), stick_zone of the points in
+    state stick and its half-width, the slip zones left and right of the stick zone's centre
+    (points in state slip) with the sign of their weighted plastic slip (slip_sign_left/right),
+    its largest magnitude (max_slip_left/right), opposite_slip, and the points per state."""
+    from .solver import zone_ends
+
+    x, state, slip, p, w = (pts[k] for k in ("x", "state", "slip", "p_n", "w"))
+    xl, xr = zone_ends(x, state != 0, pts["gap_n"])
+    sl, sr = zone_ends(x, state == 1)
+
+    def side(mask):
+        a, b = zone_ends(x, mask)
+        if a is None:
+            return None, None, None
+        s = np.sum(w[mask] * slip[mask])  # weighted plastic slip of the zone
+        return [float(a), float(b)], int(np.sign(s)), float(np.max(np.abs(slip[mask])))
+
+    centre = 0.5 * (sl + sr) if sl is not None else 0.5 * (x[0] + x[-1]) if x.size else 0.0
+    left, sign_l, max_l = side((state == 2) & (x < centre))
+    right, sign_r, max_r = side((state == 2) & (x > centre))
+    return dict(
+        contact_half_width=None if xl is None else 0.5 * (xr - xl),
+        contact_zone=None if xl is None else [float(xl), float(xr)],
+        peak_pressure=float(p.max()) if p.size else None,
+        contact_force=float(np.sum(w * p)),
+        stick_half_width=None if sl is None else 0.5 * (sr - sl),
+        stick_zone=None if sl is None else [float(sl), float(sr)],
+        slip_zone_left=left,
+        slip_zone_right=right,
+        slip_sign_left=sign_l,
+        slip_sign_right=sign_r,
+        max_slip_left=max_l,
+        max_slip_right=max_r,
+        opposite_slip=None if sign_l is None or sign_r is None else bool(sign_l * sign_r < 0),
+        num_points={n: int(np.sum(state == k)) for k, n in enumerate(("open", "stick", "slip"))},
+    )
