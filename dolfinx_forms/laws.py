@@ -52,15 +52,20 @@ class Law:
                                                if isinstance(v, (int, float, str))}}
 
 
-class LinearElastic(Law):
-    """Isotropic linear elasticity, plane strain: sigma = 2 mu eps + lambda tr(eps) I."""
+class IsotropicLaw(Law):
+    """A law with Young's modulus E and Poisson ratio nu (Lame mu, lmbda)."""
 
     def __init__(self, E, nu):
         if not (E > 0 and -1 < nu < 0.5):
-            raise ValueError(f"LinearElastic: need E > 0 and -1 < nu < 0.5, got E={E}, nu={nu}")
+            raise ValueError(f"{type(self).__name__}: need E > 0 and -1 < nu < 0.5, got "
+                             f"E={E}, nu={nu}")
         self.E, self.nu = float(E), float(nu)
         self.mu, self.lmbda = lame(self.E, self.nu)
         self.modulus, self.p_modulus = self.E, 2 * self.mu + self.lmbda
+
+
+class LinearElastic(IsotropicLaw):
+    """Isotropic linear elasticity, plane strain: sigma = 2 mu eps + lambda tr(eps) I."""
 
     def stress(self, u):
         e = strain(u)
@@ -100,7 +105,7 @@ class OrthotropicElastic(Law):
         return R * sm * R.T
 
 
-class NeoHookean(Law):
+class NeoHookean(IsotropicLaw):
     """Compressible neo-Hookean, plane strain (F_33 = 1), finite strain:
 
     psi = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2,  P = mu (F - F^-T) + lambda ln J F^-T,
@@ -108,13 +113,6 @@ class NeoHookean(Law):
     """
 
     linear = False
-
-    def __init__(self, E, nu):
-        if not (E > 0 and -1 < nu < 0.5):
-            raise ValueError(f"NeoHookean: need E > 0 and -1 < nu < 0.5, got E={E}, nu={nu}")
-        self.E, self.nu = float(E), float(nu)
-        self.mu, self.lmbda = lame(self.E, self.nu)
-        self.modulus, self.p_modulus = self.E, 2 * self.mu + self.lmbda
 
     def stress(self, u):
         F = ufl.Identity(len(u)) + ufl.grad(u)
