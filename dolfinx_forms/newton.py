@@ -48,7 +48,10 @@ def newton(problem, lam):
         r = problem.residual(lam, with_tangent=True)
         residuals.append(r)
         if not np.isfinite(r):
-            return False, residuals, f"non-finite residual at iteration {it}"
+            return False, residuals, (
+                f"non-finite residual at iteration {it} (a singular system? every body needs "
+                "its rigid motions held by Dirichlet conditions or by contact; a frictionless "
+                "body can slide along the contact)")
         if r0 is None:
             r0 = max(r, opts.atol)
         if r <= max(opts.rtol * r0, opts.atol):
