@@ -36,6 +36,17 @@ from .results import PhaseTimer, new_metrics
 
 __all__ = ["Run", "run_case", "compute", "write", "traction_plot"]
 
+# parameters that Run.contact_problem passes on: {parameter: ContactProblem argument}
+PROBLEM_OPTIONS = {
+    "mu": "mu",
+    "eps0": "eps0",
+    "degree": "degree",
+    "gauss": "num_gauss",
+    "ghost_penalty": "ghost_penalty",
+    "grid_refine": "grid_refine",
+    "petsc": "petsc_options",
+}
+
 
 @dataclass
 class Run:
@@ -81,16 +92,7 @@ class Run:
         p, opts = self.params, {"timer": self.timer, "dirichlet": dirichlet}
         if "E" in p:
             opts["materials"] = {b.tag: (p["E"], p["nu"]) for b in self.scene.bodies}
-        names = dict(
-            mu="mu",
-            eps0="eps0",
-            degree="degree",
-            ghost_penalty="ghost_penalty",
-            grid_refine="grid_refine",
-            gauss="num_gauss",
-            petsc="petsc_options",
-        )
-        opts.update({names[k]: p[k] for k in names if k in p})
+        opts.update({arg: p[k] for k, arg in PROBLEM_OPTIONS.items() if k in p})
         opts.update(kw)
         return ContactProblem(self.scene, opts.pop("materials"), **opts)
 

@@ -97,13 +97,24 @@ def describe(load):
     return f"{b}.u_{'all' if load.component is None else 'xyz'[load.component]}"
 
 
+def _global(problem, v):
+    """A float, or (min, max) of a per-dof array over every rank (collective; a rank may hold
+    none of the condition's dofs)."""
+    if np.ndim(v) == 0:
+        return float(v)
+    from mpi4py import MPI
+
+    lo = problem.comm.allreduce(float(np.min(v, initial=np.inf)), op=MPI.MIN)
+    return lo, problem.comm.allreduce(float(np.max(v, initial=-np.inf)), op=MPI.MAX)
+
+
 def _fmt(v):
-    return f"{v:.6g}" if np.ndim(v) == 0 else f"[{np.min(v):.4g} .. {np.max(v):.4g}]"
+    return f"{v:.6g}" if np.ndim(v) == 0 else f"[{v[0]:.4g} .. {v[1]:.4g}]"
 
 
 def _record(v):
-    """A value for metrics.json: the float, or the range of a per-dof array."""
-    return float(v) if np.ndim(v) == 0 else {"min": float(np.min(v)), "max": float(np.max(v))}
+    """A value for metrics.json: the float, or the range (min, max) of a per-dof array."""
+    return float(v) if np.ndim(v) == 0 else {"min": v[0], "max": v[1]}
 
 
 def _move(problem, moves, steps, label):
@@ -149,7 +160,7 @@ def ramp(problem, bc, target, steps=1, label="ramp", boundary=None, names=None):
         ]
         boundary = named[0] if named else None
     nsteps, its = _move(problem, moves, steps, label)
-    now = [current_value(problem, ld) for ld, _ in moves]
+    now = [_global(problem, current_value(problem, ld)) for ld, _ in moves]
     values = {n: _record(v) for n, v in zip(names, now)}
     rec = StageRecord("ramp", label, nsteps, its, values=values, boundary=boundary)
     reached = ", ".join(f"{n} = {_fmt(v)}" for n, v in zip(names, now))
