@@ -97,3 +97,47 @@ def test_neo_hookean_punch_large_load_quadratic_newton():
     # at 15 % indentation the finite-strain response differs measurably from the linear one
     lin = punch(scene, LinearElastic(E, NU), 0.15 * H).reaction("punch")[1]
     assert abs(p.reaction("punch")[1] - lin) > 1e-3 * abs(lin)
+
+
+def cut_block_scene():
+    """The block on a cut grid, its bottom cut by the slanted line y = 0.1 + 0.1 x (cut cells
+    all along it), clamped on its left and right sides, the punch on the top."""
+    from meshes.from_spec import build_scene
+
+    from dolfinx_forms import scene_spec
+
+    spec = scene_spec.load({
+        "name": "cut_punch",
+        "discretization": {"kind": "cut", "h": 1 / 16, "extent": [[-W / 2, 0.0], [W / 2, H]]},
+        "bodies": [{"name": "block", "window": [[-W / 2, 0.0], [W / 2, H]],
+                    "shape": {"type": "half_plane", "point": [0.0, 0.1], "normal": [0.1, -1.0]},
+                    "law": {"type": "linear", "E": E, "nu": NU}}],
+        "boundaries": [{"name": "sides", "body": "block", "side": ["left", "right"]},
+                       {"name": "punch", "box": {"x_min": -A, "x_max": A, "y_min": H - 1e-9,
+                                                 "y_max": H + 1e-9}}],
+    })
+    return build_scene(MPI.COMM_WORLD, spec)
+
+
+def cut_punch(scene, law, depth):
+    bcs = [Dirichlet("sides", None, 0.0), Dirichlet("punch", 0, 0.0),
+           Dirichlet("punch", 1, lambda lam: -lam * depth)]
+    p = ContactProblem(scene, {1: law}, dirichlet=bcs, newton=NewtonOptions(rtol=1e-11),
+                       log=lambda *a: None)
+    p.solve(1)
+    return p
+
+
+def test_neo_hookean_on_cut_cells_linear_limit_and_quadratic_newton():
+    scene = cut_block_scene()
+    assert scene.cut is not None and np.any(scene.cut.kind_tags.values == 1)  # cells are cut
+    d = 1e-6 * H
+    lin = cut_punch(scene, LinearElastic(E, NU), d).reaction("punch")[1]
+    nh = cut_punch(scene, NeoHookean(E, NU), d).reaction("punch")[1]
+    assert lin < 0 and abs(nh - lin) <= 1e-4 * abs(lin)
+    p = cut_punch(scene, NeoHookean(E, NU), 0.1 * H)  # 10 % indentation of a clamped block
+    rr = np.array(p.steps[-1].residuals) / p.steps[-1].residuals[0]
+    tail = [k for k in range(1, len(rr)) if rr[k - 1] < 1e-2 and rr[k] > 1e-14]
+    assert tail, rr
+    for k in tail:
+        assert np.log10(rr[k]) <= 1.6 * np.log10(rr[k - 1]), rr
