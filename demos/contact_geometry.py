@@ -1,17 +1,18 @@
 #!/usr/bin/python3
 """Contact geometry of the Hertz set-up: the intermediate surface between a cylinder and a block.
 
-Physics and check first
------------------------
-A cylinder of radius R sits at a gap g above a block (both level sets on one structured
-grid of spacing h). The unbiased contact surface Gamma_c is the zero contour of
+Physics. A cylinder of radius R sits at a gap g above a block (both level sets on one
+structured grid of spacing h). The unbiased contact surface Gamma_c is the zero contour of
 phi_int = (phi_block - phi_cyl)/2 (eq 23) inside the contact region (eq 22). For a flat
 face and a circle that curve is the parabola y = (x^2 + 2Rg + g^2) / (2(2R + g)), and at
 a point of it at distance d from both bodies the initial normal gap (eq 28) is
-g_n0 = d |n_block - n_cyl|. The demo builds Gamma_c, projects its quadrature points onto
-both bodies (eq 25), and reports the errors of position and gap against these formulas.
+g_n0 = d |n_block - n_cyl|.
+
+The check. The demo builds Gamma_c, projects its quadrature points onto both bodies (eq 25),
+and reports the errors of position and gap against these formulas.
 
 Run: /usr/bin/python3 demos/contact_geometry.py [--R 10 --gap 0.02 --h 0.05 --out DIR]
+Results and discussion: docs/demos.md#contact-geometry
 """
 
 import csv

@@ -4,25 +4,15 @@
 Physics. demos/hertz.py presses a half-cylinder (R = 10 mm) onto a block of the same material
 (E = 10 GPa, nu = 0.3, plane strain) with a line load P = 430 N/mm; Hertz gives
 E* = E / (2 (1 - nu^2)), a = sqrt(4 P R / (pi E*)) ~ 1 mm, p0 = 2 P / (pi a) and
-p(x) = p0 sqrt(1 - x^2/a^2). The computed solution differs from Hertz by
-  * the discretisation: the contact pressure is a traction (a stress), one order below the
-    displacement; p(x) has an infinite slope at x = +-a, so near the edges it is resolved to
-    O(sqrt(h)) on a strip of width O(h), which alone limits the L2 error of p(x) to O(h);
-  * the penalty eps_n = eps0 h / E (eq 51): a compliance O(eps0 h) and an element-scale ripple
-    O(h / eps0) of the point-wise pressure. Both vanish like h since eps_n is tied to h;
-  * small-strain kinematics and the finite body (40 x 20 mm block): a few 1e-4, far below
-    the errors studied here.
+p(x) = p0 sqrt(1 - x^2/a^2). The traction p(x) has an infinite slope at x = +-a and the
+penalty eps_n = eps0 h / E is tied to h, so the L2 error of p(x) is expected to be O(h).
 
 The check. With h = a/k for k in --sizes (default 10, 20, 40, 80) the relative L2 error of
 p(x) must decrease monotonically at an observed rate near 1 (least-squares slope of log error
-vs log h; the check accepts >= 0.75). The half-width a is where the normal gap, linearly
-interpolated between the last active and the first open contact point (spacing ~h/8 on
-Gamma_c), changes sign: near the edge the gap grows like |x - a|^(3/2) and the penalty lets it
-go negative inside, so the error of a depends on where the edge falls between two points and
-need not decrease monotonically; the peak pressure p0 is the largest point value and carries
-the penalty ripple. Their rates are reported, not checked. Both discretisations are studied by
-default: body-fitted (gmsh, P1 triangles) and cut (level sets on a graded structured grid, Q1,
-hertz.py's ghost penalty).
+vs log h; the check accepts >= 0.75). The rates of a (from the zero of the interpolated gap)
+and of p0 (the largest point pressure) are reported, not checked. Both discretisations are
+studied by default: body-fitted (gmsh, P1 triangles) and cut (level sets on a graded
+structured grid, Q1, hertz.py's ghost penalty).
 
 Outputs in --out (default results/convergence, replaced atomically when every run is done):
   convergence.json  the case, per run h, dofs, phase times, a, p0 and the three errors, per
@@ -33,9 +23,7 @@ A failed run is recorded with its error and left out of the fits (exit status 1)
 
 Run: /usr/bin/python3 demos/convergence_study.py [--discretization {conforming,cut,both}]
          [--sizes 10,20,40,80] [--out results/convergence] [--timeout 3600]
-(the default study takes about 6 minutes on 2 cores, most of it in the two runs at a/80).
-The sweep (one process per run), the fits, plot and table are dolfinx_forms/study.py; run_hertz,
-VARIANTS and CASE here are shared with benchmarks/work_precision.py.
+Results and discussion: docs/demos.md#convergence-study
 """
 
 import signal
@@ -43,35 +31,14 @@ import sys
 import tempfile
 from pathlib import Path
 
-from dolfinx_forms import analytic, cli, study
+from dolfinx_forms import cli, study
 from dolfinx_forms.folders import OutputFolderError
-from dolfinx_forms.study import PHASES, decreasing, loglog_rate  # noqa: F401 (work_precision)
+from dolfinx_forms.study import CASE, ERROR_LABELS, ERRORS, VARIANTS, hertz_reference, run_hertz
 
-ROOT = Path(__file__).resolve().parents[1]
-HERTZ = ROOT / "demos" / "hertz.py"
-# The Hertz case (the defaults of demos/hertz.py), passed explicitly to every run so that the
-# mesh sizes a/k placed here and the case solved there cannot drift apart.
-CASE = dict(R=10.0, E=1.0e4, nu=0.3, load=430.0)
-VARIANTS = {  # name -> hertz.py arguments selecting the discretisation
-    "p1-tri": [],
-    "p2-tri": ["--degree", "2"],
-    "p1-quad": ["--quads"],
-    "p2-quad": ["--degree", "2", "--quads"],
-    "q1-cut": ["--discretization", "cut"],
-}
+# benchmarks/work_precision.py reaches the Hertz runner through this module
+from dolfinx_forms.study import HERTZ, PHASES, decreasing, loglog_rate, variant_path  # noqa: F401
+
 DISCRETIZATIONS = {"conforming": "p1-tri", "cut": "q1-cut"}  # this study's variant of each path
-ERROR_LABELS = {
-    "half_width_rel_error": "a",
-    "peak_pressure_rel_error": "p0",
-    "pressure_rel_l2_error": "p(x) L2",
-}
-ERRORS = tuple(ERROR_LABELS)
-RELATIVE = {
-    "half_width_rel_error": "contact_half_width",
-    "peak_pressure_rel_error": "peak_pressure",
-}
-# metrics.json parameters recorded with each run (the settings that change the errors)
-HERTZ_PARAMETERS = "discretization degree quads eps0 ghost_penalty grid_refine gauss width depth"
 SIZES = (10, 20, 40, 80)
 PATHS = ["conforming", "cut", "both"]
 OPTIONS = [
@@ -91,35 +58,6 @@ DEFINITIONS = dict(
     rates_definition="rates_vs_h: least-squares slope of log(error) vs log(h) over the "
     "successful runs (positive: converging); local_rates_vs_h: the slope between consecutive sizes",
 )
-
-
-def variant_path(variant):
-    """'cut' or 'conforming': the discretisation path of a variant."""
-    return "cut" if "cut" in VARIANTS[variant] else "conforming"
-
-
-def hertz_reference():
-    """Hertz half-width and peak pressure of CASE (at the requested load)."""
-    E_star = analytic.effective_modulus(CASE["E"], CASE["nu"], CASE["E"], CASE["nu"])
-    a, p0 = analytic.hertz_line(CASE["load"], CASE["R"], E_star)
-    return float(a), float(p0)
-
-
-def hertz_errors(m):
-    """The run record of a hertz.py metrics.json: its settings, size and cost, a, p0, Hertz at
-    the computed load and the errors (ERRORS)."""
-    prm, errors = m.get("parameters", {}), study.relative_errors(m, RELATIVE, ERRORS[2:])
-    settings = {k: prm.get(k) for k in HERTZ_PARAMETERS.split()}
-    return dict(hertz_parameters=settings, **study.run_summary(m), **errors)
-
-
-def run_hertz(h, variant_args=(), timeout=None, keep=None):
-    """Run demos/hertz.py (CASE, mesh size h at the contact, extra arguments) in its own
-    process (study.run_demo); `keep`: a folder that receives its metrics.json and tractions.csv."""
-    args = ["--h", repr(h), *(a for k, v in CASE.items() for a in (f"--{k}", repr(v)))]
-    script, args = HERTZ.relative_to(ROOT), [*args, *variant_args]
-    rec = study.run_demo(script, args, cwd=ROOT, evaluate=hertz_errors, timeout=timeout, keep=keep)
-    return dict(h=h, **rec)
 
 
 def parse(argv):

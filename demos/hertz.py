@@ -2,23 +2,19 @@
 """Hertz line contact, and Cattaneo-Mindlin partial slip, on body-fitted meshes or a cut grid.
 
 Physics. A half-cylinder of radius R (flat face on top) is pressed by a line load P (N/mm)
-onto a block of the same material (plane strain). Hertz: E* = E / (2 (1 - nu^2)),
-a = sqrt(4 P R / (pi E*)), p0 = 2 P / (pi a), p(x) = p0 sqrt(1 - x^2/a^2).
-With --mu > 0 and --tangential r > 0 a second stage follows: after the normal load
-(applied frictionless, so no tangential traction is locked in), friction is switched on and the
-cylinder top is moved sideways until the tangential force reaches Q = r mu P (monotonically).
-Cattaneo-Mindlin: a central stick zone of half-width c = a sqrt(1 - Q/(mu P)).
+onto a block of the same material (plane strain), clamped at its bottom. Hertz:
+E* = E / (2 (1 - nu^2)), a = sqrt(4 P R / (pi E*)), p0 = 2 P / (pi a),
+p(x) = p0 sqrt(1 - x^2/a^2). With --mu > 0 and --tangential r > 0 a second stage follows: after
+the normal load (applied frictionless, so no tangential traction is locked in), friction is
+switched on and the cylinder top is moved sideways until the tangential force reaches
+Q = r mu P. Cattaneo-Mindlin: a central stick zone of half-width c = a sqrt(1 - Q/(mu P)).
 
 The check. metrics.json holds a, p0 and the relative L2 error of p(x) against Hertz *at the
 computed load* (the reaction), the stick half-width against c at the computed Q, the Newton
-residual history and the phase timings. The block (default 40 x 20 mm for a ~ 1 mm) is
-clamped at its bottom; the cylinder top is moved rigidly (down, then sideways), so the
-cylinder can neither roll nor slide freely; the approach is iterated until the reaction equals
-the requested load P (0.1 %).
+residual history and the phase timings.
 
-Method: level sets of both bodies on a fine structured grid over the pair's search box, the
-intermediate contact surface (eqs 21-24), closest points (eq 25), penalty + Coulomb return
-mapping with its consistent tangent (Algorithm 1, eq 48), Newton with load steps.
+Run: /usr/bin/python3 demos/hertz.py [--discretization cut] [--mu 0.3 --tangential 0.5]
+Results and discussion: docs/demos.md#hertz-and-cattaneo-mindlin
 """
 
 import sys

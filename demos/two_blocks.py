@@ -5,56 +5,23 @@ slip zones of opposite slip.
 Physics. A short block [10,30]x[10,20] mm rests on a long block [0,40]x[0,10] mm (plane
 strain, E = 1e5 MPa, nu = 0.3 for both, Coulomb friction mu = 1.0). The top of the upper
 block is moved down by 1.6e-3 mm and held horizontally (u_x = 0 there); the bottom of the
-lower block is clamped (u = 0: the restatement of the example in the ILS-MPM paper does not
-give its support, clamping is our choice, recorded in metrics.json). The left and right sides
-of the lower block carry the parabolic tractions of the paper (4e11 y(0.01 - y) Pa and
-1e12 y(0.01 - y) Pa), in N, mm, MPa with y measured from the lower-left corner:
+lower block is clamped (our choice, recorded in metrics.json). The sides of the lower block
+carry the parabolic tractions of the paper (y from the lower-left corner):
   p_x = 0.4 y (10 - y) MPa pushing inward,  p_y = 1.0 y (10 - y) MPa upward.
-The lateral squeeze shortens the top of the lower block towards its centre while the upper
-block is held: the tangential traction is antisymmetric, largest at the ends of the upper
-block, where the interface slips first (in opposite directions) when friction is low enough.
-Displacement and side loads are ramped together over --steps load steps.
+The tangential traction is antisymmetric, largest at the ends of the upper block, where the
+interface slips first (in opposite directions) when friction is low enough. Displacement and
+side loads are ramped together over --steps load steps. cut: both blocks on one uniform grid
+whose cells the interface y = 10 cuts.
 
-The check. No closed-form solution exists; the paper (and Tur et al.) show a central stick
-zone flanked by two slip zones of opposite slip, reached in 8 Newton iterations. metrics.json
-reports the stick zone [x_l, x_r] (ends of the state == stick points), the slip zones on each
-side and the sign of their committed plastic slip g_t^p (t = (-n_y, n_x), n from the lower to
-the upper block, so t = -e_x here: the lower block moving inward gives g_t^p > 0 on the left,
-< 0 on the right), the Newton iterations per step, the reaction on the top of the upper block,
-the peak pressure, the largest traction ratio max |p_t|/p_n (the friction coefficient below
-which slip starts) and sigma_x along y = 5 mm (sigma_x_line.csv: the stress averaged at the
-vertices, post.stress_at_points, as y = 5 is a grid line of the gmsh meshes). tractions.csv
-holds p_n, p_t (= tau_t along t), g_n, g_t^p and the state of the last load step ("slip":
-slipped during that step).
+The check. No closed-form solution exists; the paper shows a central stick zone flanked by two
+slip zones of opposite slip, reached in 8 Newton iterations. metrics.json reports the stick
+zone, the slip zones on each side and the sign of their plastic slip g_t^p, the Newton
+iterations per step, the reaction on the top, the peak pressure, the largest traction ratio
+max |p_t|/p_n (the friction coefficient below which slip starts) and sigma_x along y = 5 mm
+(sigma_x_line.csv). At mu = 1.0 the interface does not slip; try --mu 0.5.
 
-What we find. With the loads as restated (ramped together, one step) the interface does NOT
-slip at mu = 1.0: max |p_t|/p_n = 0.73 at h = 0.2 (0.76 at h = 1, 0.72 at h = 0.1; 0.86 and
-0.90 with eps0 = 0.1 and 0.01), reached at the ends of the upper block. The expected pattern
-appears for mu below that ratio, e.g. --mu 0.5: stick zone [12.2, 27.8] mm at h = 0.2, 8 Newton
-iterations.
-
-Penalty. eps_n = eps_t = eps0 h / E (eq 51), default eps0 = 1.0 (the paper's value): at
-mu = 0.5, h = 0.2 the stick zone is the same with eps0 = 1 and 0.1 ([12.21, 27.79] mm), the
-reaction changes by 1.5 %, the mean interpenetration eps_n p is 1.4 % of the imposed
-displacement (interface_compliance_ratio), and Newton needs 8 iterations (11 with eps0 = 0.1;
-with eps0 = 0.01 it does not converge in 25 iterations even after 6 cut-backs).
-
-Discretization. conforming (default): gmsh meshes of size h, quadrilaterals (or --triangles).
-cut: both blocks are level sets on one uniform Q1 grid over [0, 40] x [0, 20] (x spacing h,
-y spacing 20/ny <= h, ny odd), so the interface y = 10 cuts the middle of a cell row, active in
-both blocks, each integrating its own half (ghost penalty on the faces of cut cells); the side
-tractions are integrated up to y = 10 only. The contact points are those of the conforming
-path. Cut (ghost penalty 0.01) against gmsh quadrilaterals at equal h, relative L2: sigma_x
-along y = 5 within 0.4 %; p_n within 0.3 %; p_t within 0.6 % at mu = 0.5 and 2.1-3.0 % at
-mu = 1 (h = 0.2 / 1), where the corner traction is not capped by friction: the difference sits
-in the cell next to each corner of the upper block (stress singularity); away from the corners
-p_t agrees to 1 %. A ghost penalty of 0.1 roughly doubles this near the corners; gmsh triangles
-and quadrilaterals differ by as much (p_n 1.3-2.1 %, p_t 1.8-7.8 %). Newton iterations as
-conforming (2 at mu = 1; at mu = 0.5: 6 against 5 at h = 1, 8 at h = 0.2); stick zone
-[12.22, 27.78] mm at h = 0.2.
-
-Method: level sets of both bodies, the intermediate contact surface (eqs 21-24), closest points
-(eq 25), penalty + Coulomb return mapping with its consistent tangent (Algorithm 1, eq 48).
+Run: /usr/bin/python3 demos/two_blocks.py [--mu 0.5] [--discretization cut] [--h 0.2]
+Results and discussion: docs/demos.md#two-blocks
 """
 
 import sys
@@ -62,7 +29,7 @@ import sys
 import numpy as np
 import ufl
 
-from dolfinx_forms import cli, post
+from dolfinx_forms import cli, compare, post
 from dolfinx_forms.demo import run_case
 from dolfinx_forms.output import write_columns
 from dolfinx_forms.protocol import friction_on, ramp
@@ -84,6 +51,7 @@ OPTIONS = [  # option, kind, default[, help]
     ("--degree", [1, 2], 1),
 ]
 CELLS = (
+    True,
     "quadrilateral cells (default; the cut grid is always quadrilateral)",
     "triangular cells (conforming only; ignored with cut)",
 )
@@ -98,17 +66,8 @@ SUPPORTS = (
 
 
 def parse(argv):
-    p = cli.DemoParser(prog="two_blocks.py", description=__doc__.split("\n\n")[0])
-    p.add_out("results/two_blocks")
-    cli.add_discretization(p)
-    cli.add_options(p, OPTIONS)
-    cells = p.add_mutually_exclusive_group()
-    cells.add_argument("--quads", dest="quads", action="store_true", default=True, help=CELLS[0])
-    cells.add_argument("--triangles", dest="quads", action="store_false", help=CELLS[1])
-    cli.add_petsc(p)
-    a = p.parse_args(argv)
-    cli.check_discretization(p, a)
-    return a
+    p = cli.demo_parser("two_blocks.py", __doc__, "results/two_blocks", OPTIONS, cells=CELLS)
+    return p.parse_args(argv)
 
 
 def scene(run):
@@ -172,8 +131,7 @@ def evaluate(run):
         res.update(max_traction_ratio=None, interface_compliance_ratio=None)
     sx = run.data["sigma_x"]
     res["sigma_x_line"] = dict(y=5.0, file="sigma_x_line.csv", min=sx.min(), max=sx.max())
-    x, mp = pts["x"], prm["mu"] * pts["p_n"]
-    run.curves = {"+- mu p_n (slip limit)": (np.r_[x, np.nan, x], np.r_[mp, np.nan, -mp])}
+    run.curves = compare.slip_limit(pts, prm["mu"])
     if res["stick_zone"] is not None:  # marked on the axis
         run.curves["stick zone"] = (np.array(res["stick_zone"]), np.zeros(2))
     h = run.metrics["mesh"]["h_contact"]

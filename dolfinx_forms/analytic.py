@@ -43,3 +43,20 @@ def mindlin_shear(x, a, c, p0, mu):
 def patch_pressure(E, nu, strain):
     """Uniform contact pressure of the plane-strain patch test with free sides: E/(1-nu^2) e."""
     return E / (1 - nu**2) * strain
+
+
+def inclined_uniaxial_state(E, nu, d, height, slope, eps_n=0.0, eps_t=0.0):
+    """The uniform uniaxial state (sigma_yy = -s, sigma_xx = tau_xy = 0, plane strain) of a
+    column of height `height` shortened by d and crossed by the interface of slope tan theta,
+    bonded by penalty springs eps_n, eps_t (eqs 8, 51: the jump g = eps_n tau_n n + eps_t tau_t
+    t = s g1), so the top moves by -d = -s (1 - nu^2) height / E + s g1_y. n: unit normal of
+    the interface pointing up (lower -> upper), t = (-n_y, n_x); the traction on it is
+    (0, -s cos theta). Returns s, the lateral strain exx = nu (1 + nu) s / E, the horizontal
+    jump gx = s g1_x, the pressure p_n = s cos^2 theta and the shear tau_t along t."""
+    n = np.array([-slope, 1.0]) / np.hypot(1.0, slope)
+    t = np.array([-n[1], n[0]])
+    tv = np.array([0.0, -1.0]) * n[1]  # (tau_n n + tau_t t) per unit s: (0, -cos theta)
+    tau_n, tau_t = tv @ n, tv @ t
+    g1 = eps_n * tau_n * n + eps_t * tau_t * t
+    s = d / ((1 - nu**2) * height / E - g1[1])
+    return dict(s=s, exx=nu * (1 + nu) * s / E, gx=s * g1[0], p_n=-s * tau_n, tau_t=s * tau_t)

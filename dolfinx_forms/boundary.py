@@ -85,3 +85,24 @@ def dirichlet_dofs(V, scene, condition):
         dofs = [fem.locate_dofs_topological(V.sub(c), V.mesh.topology.dim - 1, facets)
                 for c in comps]
     return np.concatenate(dofs).astype(np.int32)
+
+
+def nearest_vertex_marker(mesh, point, on=None):
+    """A Dirichlet marker x (3, n) -> bool that selects the one mesh vertex nearest to `point`
+    among those where on(x) holds (a predicate on coordinates (3, n); default: every vertex),
+    e.g. the bottom vertex nearest to the middle of a roller support. Collective: every rank
+    selects the same vertex (ties: the smaller coordinates). Raises ValueError if no vertex
+    qualifies."""
+    gdim = mesh.geometry.dim
+    X = mesh.geometry.x
+    X = X[on(X.T)] if on is not None else X
+    p = np.zeros(3)
+    p[: len(point)] = point
+    d = np.linalg.norm(X[:, :gdim] - p[:gdim], axis=1)
+    k = np.argmin(d) if d.size else None
+    mine = (float(d[k]), tuple(X[k, :gdim])) if d.size else (np.inf, ())
+    dist, c = min(mesh.comm.allgather(mine))
+    if not np.isfinite(dist):
+        raise ValueError("nearest_vertex_marker: no vertex satisfies `on`")
+    c = np.array(c)
+    return lambda x: np.all(np.isclose(x[:gdim].T, c), axis=1)

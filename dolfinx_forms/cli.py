@@ -173,18 +173,28 @@ def petsc_options(parser, items):
     return opts
 
 
-def demo_parser(prog, doc, out, options=(), discretization=True, petsc=True):
+def demo_parser(prog, doc, out, options=(), discretization=True, petsc=True, cells=None):
     """A demo's parser: the description is the first paragraph of `doc`; --out (default `out`)
     and --force, --discretization and --ghost-penalty (add_discretization), the `options`
-    table (add_options), --petsc (add_petsc)."""
+    table (add_options), --quads/--triangles (add_cells, with cells = (quads by default,
+    help of --quads, help of --triangles)), --petsc (add_petsc)."""
     p = DemoParser(prog=prog, description=doc.split("\n\n")[0])
     p.add_out(out)
     if discretization:
         add_discretization(p)
     add_options(p, options)
+    if cells is not None:
+        add_cells(p, *cells)
     if petsc:
         add_petsc(p)
     return p
+
+
+def add_cells(parser, quads, quads_help, triangles_help):
+    """--quads / --triangles, mutually exclusive, into args.quads (default `quads`)."""
+    cells = parser.add_mutually_exclusive_group()
+    cells.add_argument("--quads", dest="quads", action="store_true", default=quads, help=quads_help)
+    cells.add_argument("--triangles", dest="quads", action="store_false", help=triangles_help)
 
 
 def add_discretization(parser):

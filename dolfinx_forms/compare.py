@@ -10,7 +10,7 @@ import numpy as np
 
 from . import analytic
 
-__all__ = ["rel_l2", "contact_results", "hertz", "patch"]
+__all__ = ["rel_l2", "contact_results", "hertz", "patch", "slip_limit", "extreme", "slip_results"]
 
 
 def rel_l2(w, a, b):
@@ -98,3 +98,42 @@ def patch(pts, E, nu, displacement, height, eps_n):
     }
     xs = np.array([pts["x"].min(), pts["x"].max()])
     return res, an, {"exact": (xs, [exact] * 2), "penalised": (xs, [penalised] * 2)}
+
+
+def slip_limit(pts, mu):
+    """The Coulomb limit +- mu p_n at the contact points, as a plot curve {label: (x, y)} (the
+    two branches separated by a NaN)."""
+    x, mp = pts["x"], mu * pts["p_n"]
+    return {"+- mu p_n (slip limit)": (np.r_[x, np.nan, x], np.r_[mp, np.nan, -mp])}
+
+
+def extreme(a, f=np.max):
+    """float(f(a)), None for an empty array (a metrics.json value)."""
+    return float(f(a)) if a.size else None
+
+
+def slip_results(pts, interior, tol):
+    """Slip measures of a frictional interface: the verdict `slips` (the committed plastic
+    slip exceeds `tol` at an `interior` point, a mask of the contact points that leaves out
+    the ends, where the geometry is less accurate), the largest plastic slip and the fraction
+    of slipping points (all active points and interior ones), the slipping points outside
+    the interior (end_slip_points), the points per state, and the range of the traction
+    ratio |p_t|/p_n (interior, and _all: every active point)."""
+    state, slip, pn, q = (pts[k] for k in ("state", "slip", "p_n", "p_t"))
+    active = state != 0
+    ratio, ratio_i = (np.abs(q[m]) / pn[m] for m in (active, interior))
+    gi = np.abs(slip[interior])
+    return dict(
+        slips=bool(gi.size and gi.max() > tol),
+        max_plastic_slip=extreme(np.abs(slip)),
+        max_plastic_slip_interior=extreme(gi),
+        slip_fraction=extreme(state[active] == 2, np.mean),
+        slip_fraction_interior=extreme(state[interior] == 2, np.mean),
+        end_slip_points=int(np.sum((state == 2) & ~interior)),
+        num_points={n: int(np.sum(state == k)) for k, n in enumerate(("open", "stick", "slip"))},
+        traction_ratio_min=extreme(ratio_i, np.min),
+        traction_ratio_max=extreme(ratio_i),
+        traction_ratio_min_all=extreme(ratio, np.min),
+        traction_ratio_max_all=extreme(ratio),
+        slip_threshold_mm=tol,
+    )

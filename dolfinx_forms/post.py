@@ -15,7 +15,7 @@ and on a cut scene their cells overlap along the interface.
 
 import numpy as np
 
-__all__ = ["stress_at_points", "contact_zones"]
+__all__ = ["stress_at_points", "contact_zones", "tangential_jumps"]
 
 
 def stress_at_points(problem, points, component=(0, 0), body=0):
@@ -104,3 +104,11 @@ def contact_zones(pts):
         opposite_slip=None if sign_l is None or sign_r is None else bool(sign_l * sign_r < 0),
         num_points={n: int(np.sum(state == k)) for k, n in enumerate(("open", "stick", "slip"))},
     )
+
+
+def tangential_jumps(problem):
+    """The committed total tangential jump g_t (elastic + plastic) at the contact points of
+    every pair: (x, g_t) on rank 0 (empty arrays elsewhere), in the order of the pairs."""
+    local = [(g.points[:, 0], s["g_t"]) for g, s in zip(problem.pairs, problem.contact.committed)]
+    every = [v for part in problem.comm.gather(local, root=0) or [] for v in part]
+    return tuple(np.concatenate([v[i] for v in every] or [[]]) for i in (0, 1))

@@ -22,6 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import analytic
+
 __all__ = [
     "PHASES",
     "run_demo",
@@ -34,6 +36,14 @@ __all__ = [
     "plot_errors",
     "print_errors",
     "write_study",
+    "CASE",
+    "VARIANTS",
+    "ERRORS",
+    "ERROR_LABELS",
+    "variant_path",
+    "hertz_reference",
+    "hertz_errors",
+    "run_hertz",
 ]
 
 PHASES = ("mesh", "assembly", "contact", "solve")  # metrics.json timing_s, without total
@@ -274,3 +284,61 @@ def write_study(out, data, runs=(), runs_from=None, plot=None, *, name="converge
         raise
     except OSError as e:
         raise OutputFolderError(f"--out: cannot write {out}: {e}") from e
+
+
+# The Hertz case of demos/hertz.py, run over mesh sizes by demos/convergence_study.py and
+# benchmarks/work_precision.py (one runner for both).
+
+ROOT = Path(__file__).resolve().parents[1]  # the repository: demos/ beside dolfinx_forms/
+HERTZ = ROOT / "demos" / "hertz.py"
+# The Hertz case (the defaults of demos/hertz.py), passed explicitly to every run so that the
+# mesh sizes a/k placed here and the case solved there cannot drift apart.
+CASE = dict(R=10.0, E=1.0e4, nu=0.3, load=430.0)
+VARIANTS = {  # name -> hertz.py arguments selecting the discretisation
+    "p1-tri": [],
+    "p2-tri": ["--degree", "2"],
+    "p1-quad": ["--quads"],
+    "p2-quad": ["--degree", "2", "--quads"],
+    "q1-cut": ["--discretization", "cut"],
+}
+ERROR_LABELS = {
+    "half_width_rel_error": "a",
+    "peak_pressure_rel_error": "p0",
+    "pressure_rel_l2_error": "p(x) L2",
+}
+ERRORS = tuple(ERROR_LABELS)
+RELATIVE = {
+    "half_width_rel_error": "contact_half_width",
+    "peak_pressure_rel_error": "peak_pressure",
+}
+# metrics.json parameters recorded with each run (the settings that change the errors)
+HERTZ_PARAMETERS = "discretization degree quads eps0 ghost_penalty grid_refine gauss width depth"
+
+
+def variant_path(variant):
+    """'cut' or 'conforming': the discretisation path of a variant."""
+    return "cut" if "cut" in VARIANTS[variant] else "conforming"
+
+
+def hertz_reference():
+    """Hertz half-width and peak pressure of CASE (at the requested load)."""
+    E_star = analytic.effective_modulus(CASE["E"], CASE["nu"], CASE["E"], CASE["nu"])
+    a, p0 = analytic.hertz_line(CASE["load"], CASE["R"], E_star)
+    return float(a), float(p0)
+
+
+def hertz_errors(m):
+    """The run record of a hertz.py metrics.json: its settings, size and cost, a, p0, Hertz at
+    the computed load and the errors (ERRORS)."""
+    prm, errors = m.get("parameters", {}), relative_errors(m, RELATIVE, ERRORS[2:])
+    settings = {k: prm.get(k) for k in HERTZ_PARAMETERS.split()}
+    return dict(hertz_parameters=settings, **run_summary(m), **errors)
+
+
+def run_hertz(h, variant_args=(), timeout=None, keep=None):
+    """Run demos/hertz.py (CASE, mesh size h at the contact, extra arguments) in its own
+    process (run_demo); `keep`: a folder that receives its metrics.json and tractions.csv."""
+    args = ["--h", repr(h), *(a for k, v in CASE.items() for a in (f"--{k}", repr(v)))]
+    script, args = HERTZ.relative_to(ROOT), [*args, *variant_args]
+    rec = run_demo(script, args, cwd=ROOT, evaluate=hertz_errors, timeout=timeout, keep=keep)
+    return dict(h=h, **rec)
