@@ -86,8 +86,17 @@ def scene(path, h, comm=MPI.COMM_WORLD, geometry=GEOMETRY, h_far=H_FAR):
     raise ValueError(f"path must be 'fitted' or 'cut', got {path!r}")
 
 
-def run_path(path, h, law=None, delta=DELTA, geometry=GEOMETRY, eps0=EPS0, h_far=H_FAR,
-             steps=1, comm=MPI.COMM_WORLD):
+def run_path(
+    path,
+    h,
+    law=None,
+    delta=DELTA,
+    geometry=GEOMETRY,
+    eps0=EPS0,
+    h_far=H_FAR,
+    steps=1,
+    comm=MPI.COMM_WORLD,
+):
     """One solve: the indenter top moved down by delta (held horizontally), frictionless.
     Returns the record (see the module docstring); points on rank 0 only."""
     law = ortho_law() if law is None else law
@@ -97,23 +106,37 @@ def run_path(path, h, law=None, delta=DELTA, geometry=GEOMETRY, eps0=EPS0, h_far
     g = geometry
     band = ellipse_sag(g["R"], g["Ry"], g["zone"])  # the initial gap at x = +-zone
     problem = ContactProblem(
-        sc, {b.tag: law for b in sc.bodies}, mu=0.0, eps0=eps0, band=band,
-        dirichlet=[Dirichlet("block_bottom", None, 0.0), Dirichlet("cylinder_top", 0, 0.0),
-                   top_y], log=lambda *a, **k: None)
+        sc,
+        {b.tag: law for b in sc.bodies},
+        mu=0.0,
+        eps0=eps0,
+        band=band,
+        dirichlet=[Dirichlet("block_bottom", None, 0.0), Dirichlet("cylinder_top", 0, 0.0), top_y],
+        log=lambda *a, **k: None,
+    )
     ramp(problem, top_y, -delta, steps=steps)
     reaction = problem.reaction("block_bottom")
     pts = gather_points(problem)
-    rec = dict(path=path, h=float(h), dofs=int(problem.num_dofs),
-               cells=int(sc.mesh.topology.index_map(2).size_global),
-               newton_iterations=int(sum(s.iterations for s in problem.steps)),
-               reaction=[float(f) for f in reaction], time_s=time.perf_counter() - t0)
+    rec = dict(
+        path=path,
+        h=float(h),
+        dofs=int(problem.num_dofs),
+        cells=int(sc.mesh.topology.index_map(2).size_global),
+        newton_iterations=int(sum(s.iterations for s in problem.steps)),
+        reaction=[float(f) for f in reaction],
+        time_s=time.perf_counter() - t0,
+    )
     if pts is not None:
         xl, xr = zone_ends(pts["x"], pts["state"] != 0, pts["gap_n"])
-        rec.update(half_width=0.5 * (xr - xl), centre=0.5 * (xr + xl),
-                   half_width_moment=moment_half_width(pts["x"], pts["p_n"], pts["w"]),
-                   x=pts["x"].tolist(),
-                   p=pts["p_n"].tolist(), w=pts["w"].tolist(),
-                   contact_force=float(np.sum(pts["w"] * pts["p_n"])))
+        rec.update(
+            half_width=0.5 * (xr - xl),
+            centre=0.5 * (xr + xl),
+            half_width_moment=moment_half_width(pts["x"], pts["p_n"], pts["w"]),
+            x=pts["x"].tolist(),
+            p=pts["p_n"].tolist(),
+            w=pts["w"].tolist(),
+            contact_force=float(np.sum(pts["w"] * pts["p_n"])),
+        )
     return rec
 
 
@@ -139,18 +162,26 @@ def pressure_diff(ref, other, average=None):
 def compare(fit, cut):
     """The path differences at one h (see the module docstring)."""
     P_f, P_c = fit["reaction"][1], cut["reaction"][1]
-    return dict(h=fit["h"], reaction_rel_diff=abs(P_f - P_c) / abs(P_f),
-                reaction_x_diff=abs(fit["reaction"][0] - cut["reaction"][0]) / abs(P_f),
-                half_width_rel_diff=abs(fit["half_width"] - cut["half_width"]) / fit["half_width"],
-                half_width_moment_rel_diff=abs(fit["half_width_moment"] - cut["half_width_moment"])
-                / fit["half_width_moment"],
-                centre_diff=abs(fit["centre"] - cut["centre"]) / fit["half_width"],
-                pressure_rel_l2_diff=pressure_diff(fit, cut),
-                pressure_rel_l2_diff_averaged=pressure_diff(fit, cut, average=fit["h"]))
+    return dict(
+        h=fit["h"],
+        reaction_rel_diff=abs(P_f - P_c) / abs(P_f),
+        reaction_x_diff=abs(fit["reaction"][0] - cut["reaction"][0]) / abs(P_f),
+        half_width_rel_diff=abs(fit["half_width"] - cut["half_width"]) / fit["half_width"],
+        half_width_moment_rel_diff=abs(fit["half_width_moment"] - cut["half_width_moment"])
+        / fit["half_width_moment"],
+        centre_diff=abs(fit["centre"] - cut["centre"]) / fit["half_width"],
+        pressure_rel_l2_diff=pressure_diff(fit, cut),
+        pressure_rel_l2_diff_averaged=pressure_diff(fit, cut, average=fit["h"]),
+    )
 
 
-DIFFS = ("reaction_rel_diff", "half_width_rel_diff", "half_width_moment_rel_diff",
-         "pressure_rel_l2_diff", "pressure_rel_l2_diff_averaged")
+DIFFS = (
+    "reaction_rel_diff",
+    "half_width_rel_diff",
+    "half_width_moment_rel_diff",
+    "pressure_rel_l2_diff",
+    "pressure_rel_l2_diff_averaged",
+)
 
 
 def rates(comparisons):
@@ -176,44 +207,56 @@ def run_all(hs=HS, comm=MPI.COMM_WORLD):
 
 def table(records, comparisons):
     by = {(r["path"], r["h"]): r for r in records}
-    lines = [f"{'h':>6} {'dofs fit':>9} {'dofs cut':>9} {'Fy fit':>10} {'Fy cut':>10} "
-             f"{'dFy/Fy':>9} {'a fit':>7} {'a cut':>7} {'da/a':>9} {'dam/am':>9} {'dp L2':>8} "
-             f"{'dp avg':>8} {'t fit s':>7} {'t cut s':>7}"]
+    lines = [
+        f"{'h':>6} {'dofs fit':>9} {'dofs cut':>9} {'Fy fit':>10} {'Fy cut':>10} "
+        f"{'dFy/Fy':>9} {'a fit':>7} {'a cut':>7} {'da/a':>9} {'dam/am':>9} {'dp L2':>8} "
+        f"{'dp avg':>8} {'t fit s':>7} {'t cut s':>7}"
+    ]
     for c in comparisons:
         f, k = by[("fitted", c["h"])], by[("cut", c["h"])]
-        lines.append(f"{c['h']:6.3g} {f['dofs']:9d} {k['dofs']:9d} {f['reaction'][1]:10.2f} "
-                     f"{k['reaction'][1]:10.2f} {c['reaction_rel_diff']:9.2e} "
-                     f"{f['half_width']:7.4f} {k['half_width']:7.4f} "
-                     f"{c['half_width_rel_diff']:9.2e} {c['half_width_moment_rel_diff']:9.2e} "
-                     f"{c['pressure_rel_l2_diff']:8.2e} "
-                     f"{c['pressure_rel_l2_diff_averaged']:8.2e} {f['time_s']:7.2f} "
-                     f"{k['time_s']:7.2f}")
+        lines.append(
+            f"{c['h']:6.3g} {f['dofs']:9d} {k['dofs']:9d} {f['reaction'][1]:10.2f} "
+            f"{k['reaction'][1]:10.2f} {c['reaction_rel_diff']:9.2e} "
+            f"{f['half_width']:7.4f} {k['half_width']:7.4f} "
+            f"{c['half_width_rel_diff']:9.2e} {c['half_width_moment_rel_diff']:9.2e} "
+            f"{c['pressure_rel_l2_diff']:8.2e} "
+            f"{c['pressure_rel_l2_diff_averaged']:8.2e} {f['time_s']:7.2f} "
+            f"{k['time_s']:7.2f}"
+        )
     return "\n".join(lines)
 
 
 def plot(path, records, comparisons, rate_rows, iso=None):
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, (ax, axt) = plt.subplots(2, 1, figsize=(12, 9), gridspec_kw=dict(height_ratios=[3, 2]))
     h = np.array([c["h"] for c in comparisons])
-    labels = {"reaction_rel_diff": "reaction |dFy|/Fy", "half_width_rel_diff": "half-width |da|/a",
-              "half_width_moment_rel_diff": "moment half-width |da_m|/a_m",
-              "pressure_rel_l2_diff": "p(x) rel. L2",
-              "pressure_rel_l2_diff_averaged": "p(x) rel. L2, averaged over h"}
+    labels = {
+        "reaction_rel_diff": "reaction |dFy|/Fy",
+        "half_width_rel_diff": "half-width |da|/a",
+        "half_width_moment_rel_diff": "moment half-width |da_m|/a_m",
+        "pressure_rel_l2_diff": "p(x) rel. L2",
+        "pressure_rel_l2_diff_averaged": "p(x) rel. L2, averaged over h",
+    }
     for k, lab in labels.items():
         ax.loglog(h, [c[k] for c in comparisons], "o-", label=lab)
-    ax.loglog(h, comparisons[0]["reaction_rel_diff"] * (h / h[0]) ** 2, "k:", lw=0.8,
-              label="slope 2")
-    ax.loglog(h, comparisons[0]["pressure_rel_l2_diff"] * (h / h[0]), "k--", lw=0.8,
-              label="slope 1")
+    ax.loglog(
+        h, comparisons[0]["reaction_rel_diff"] * (h / h[0]) ** 2, "k:", lw=0.8, label="slope 2"
+    )
+    ax.loglog(
+        h, comparisons[0]["pressure_rel_l2_diff"] * (h / h[0]), "k--", lw=0.8, label="slope 1"
+    )
     if iso is not None:
         ax.axhline(iso, color="r", lw=0.8, label="|Fy(orthotropic) - Fy(isotropic)| / Fy")
     ax.set_xlabel("h (mm)")
     ax.set_ylabel("body-fitted vs cut, relative difference")
-    ax.set_title("Same OrthotropicElastic law, half-ellipse on a block: body-fitted (P1) vs "
-                 "cut (Q1)", fontsize=10)
+    ax.set_title(
+        "Same OrthotropicElastic law, half-ellipse on a block: body-fitted (P1) vs " "cut (Q1)",
+        fontsize=10,
+    )
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     axt.axis("off")
@@ -227,17 +270,39 @@ def plot(path, records, comparisons, rate_rows, iso=None):
         def rate(key):
             v = rr.get(key)
             return "" if v is None else f" ({v:.2f})"
-        rows.append([f"{c['h']:g}", f"{f['dofs']}", f"{k['dofs']}", f"{f['reaction'][1]:.2f}",
-                     f"{k['reaction'][1]:.2f}", f"{c['reaction_rel_diff']:.2e}"
-                     + rate("reaction_rel_diff"),
-                     f"{c['half_width_rel_diff']:.2e}" + rate("half_width_rel_diff"),
-                     f"{c['half_width_moment_rel_diff']:.2e}" + rate("half_width_moment_rel_diff"),
-                     f"{c['pressure_rel_l2_diff']:.2e}" + rate("pressure_rel_l2_diff"),
-                     f"{f['time_s']:.1f}", f"{k['time_s']:.1f}"])
-    tab = axt.table(cellText=rows, colLabels=["h", "dofs fit", "dofs cut", "Fy fit", "Fy cut",
-                                              "dFy/Fy (rate)", "da/a (rate)", "da_m/a_m (rate)",
-                                              "dp L2 (rate)",
-                                              "t fit (s)", "t cut (s)"], loc="center")
+
+        rows.append(
+            [
+                f"{c['h']:g}",
+                f"{f['dofs']}",
+                f"{k['dofs']}",
+                f"{f['reaction'][1]:.2f}",
+                f"{k['reaction'][1]:.2f}",
+                f"{c['reaction_rel_diff']:.2e}" + rate("reaction_rel_diff"),
+                f"{c['half_width_rel_diff']:.2e}" + rate("half_width_rel_diff"),
+                f"{c['half_width_moment_rel_diff']:.2e}" + rate("half_width_moment_rel_diff"),
+                f"{c['pressure_rel_l2_diff']:.2e}" + rate("pressure_rel_l2_diff"),
+                f"{f['time_s']:.1f}",
+                f"{k['time_s']:.1f}",
+            ]
+        )
+    tab = axt.table(
+        cellText=rows,
+        colLabels=[
+            "h",
+            "dofs fit",
+            "dofs cut",
+            "Fy fit",
+            "Fy cut",
+            "dFy/Fy (rate)",
+            "da/a (rate)",
+            "da_m/a_m (rate)",
+            "dp L2 (rate)",
+            "t fit (s)",
+            "t cut (s)",
+        ],
+        loc="center",
+    )
     tab.auto_set_font_size(False)
     tab.set_fontsize(8)
     tab.scale(1, 1.4)
@@ -255,11 +320,18 @@ def floats(text):
 
 def parse(argv):
     p = DemoParser(prog="orthotropic_paths.py", description=__doc__.split("\n\n")[0])
-    p.add_argument("--out-dir", default=str(ROOT / "benchmarks" / "results"),
-                   help="folder of orthotropic_paths.json and .png (default benchmarks/results)")
-    p.add_argument("--h", type=floats, default=list(HS),
-                   help="mesh sizes, each half the previous (default 0.2,0.1,0.05,0.025; the "
-                        "zone 1.6 must be a multiple of each)")
+    p.add_argument(
+        "--out-dir",
+        default=str(ROOT / "benchmarks" / "results"),
+        help="folder of orthotropic_paths.json and .png (default benchmarks/results)",
+    )
+    p.add_argument(
+        "--h",
+        type=floats,
+        default=list(HS),
+        help="mesh sizes, each half the previous (default 0.2,0.1,0.05,0.025; the "
+        "zone 1.6 must be a multiple of each)",
+    )
     return p.parse_args(argv)
 
 
@@ -273,21 +345,39 @@ def main(argv=None):
     if comm.rank != 0:
         return 0
     ortho0 = {r["path"]: r for r in records if r["h"] == args.h[0]}
-    iso_diffs = {p: abs(iso[p]["reaction"][1] - ortho0[p]["reaction"][1])
-                 / abs(ortho0[p]["reaction"][1]) for p in PATHS}
+    iso_diffs = {
+        p: abs(iso[p]["reaction"][1] - ortho0[p]["reaction"][1]) / abs(ortho0[p]["reaction"][1])
+        for p in PATHS
+    }
     iso_diff = min(iso_diffs.values())
     rate_rows = rates(comparisons)
-    data = dict(benchmark="orthotropic_paths", git=git_head(),
-                parameters=dict(geometry=GEOMETRY, orthotropic=ORTHO, isotropic=ISO, delta=DELTA,
-                                eps0=EPS0, h_far_over_h=H_FAR, h=args.h, mu=0.0),
-                comparisons=comparisons, rates=rate_rows,
-                isotropic={p: dict(h=args.h[0], reaction=iso[p]["reaction"],
-                                   half_width=iso[p]["half_width"],
-                                   reaction_rel_diff_to_orthotropic=iso_diffs[p])
-                           for p in PATHS},
-                records=[{k: v for k, v in r.items() if k not in ("x", "p", "w")}
-                         for r in records],
-                total_time_s=time.perf_counter() - t0)
+    data = dict(
+        benchmark="orthotropic_paths",
+        git=git_head(),
+        parameters=dict(
+            geometry=GEOMETRY,
+            orthotropic=ORTHO,
+            isotropic=ISO,
+            delta=DELTA,
+            eps0=EPS0,
+            h_far_over_h=H_FAR,
+            h=args.h,
+            mu=0.0,
+        ),
+        comparisons=comparisons,
+        rates=rate_rows,
+        isotropic={
+            p: dict(
+                h=args.h[0],
+                reaction=iso[p]["reaction"],
+                half_width=iso[p]["half_width"],
+                reaction_rel_diff_to_orthotropic=iso_diffs[p],
+            )
+            for p in PATHS
+        },
+        records=[{k: v for k, v in r.items() if k not in ("x", "p", "w")} for r in records],
+        total_time_s=time.perf_counter() - t0,
+    )
     out = Path(args.out_dir)
     out.mkdir(parents=True, exist_ok=True)
     json_path, png_path = out / "orthotropic_paths.json", out / "orthotropic_paths.png"
@@ -295,17 +385,23 @@ def main(argv=None):
     def write_json(tmp):
         with open(tmp, "w") as f:
             json.dump(data, f, indent=2)
+
     write_atomic(json_path, write_json)
     plot(png_path, records, comparisons, rate_rows, iso=iso_diff)
     print(table(records, comparisons))
     for r in rate_rows:
-        print(f"rates at h={r['h']:g}: " + ", ".join(
-            f"{k} {'n/a' if r[k] is None else f'{r[k]:.2f}'}" for k in DIFFS))
-    print(f"isotropic (E={ISO['E']:g}, nu={ISO['nu']:g}) vs orthotropic reaction at h="
-          f"{args.h[0]:g}: " + ", ".join(f"{p} {d:.2%}" for p, d in iso_diffs.items())
-          + f"; Fx orthotropic {ortho0['fitted']['reaction'][0]:.4g} / "
-          f"{ortho0['cut']['reaction'][0]:.4g}, isotropic {iso['fitted']['reaction'][0]:.2g} / "
-          f"{iso['cut']['reaction'][0]:.2g}")
+        print(
+            f"rates at h={r['h']:g}: "
+            + ", ".join(f"{k} {'n/a' if r[k] is None else f'{r[k]:.2f}'}" for k in DIFFS)
+        )
+    print(
+        f"isotropic (E={ISO['E']:g}, nu={ISO['nu']:g}) vs orthotropic reaction at h="
+        f"{args.h[0]:g}: "
+        + ", ".join(f"{p} {d:.2%}" for p, d in iso_diffs.items())
+        + f"; Fx orthotropic {ortho0['fitted']['reaction'][0]:.4g} / "
+        f"{ortho0['cut']['reaction'][0]:.4g}, isotropic {iso['fitted']['reaction'][0]:.2g} / "
+        f"{iso['cut']['reaction'][0]:.2g}"
+    )
     print(f"results in {json_path.resolve()} and {png_path.resolve()}")
     return 0
 

@@ -63,7 +63,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 E, NU, D, EPS0 = 1.0, 0.3, 0.01, 1e-3
 HEIGHT = WIDTH = 1.0
-FRACTIONS = (0.5,) + tuple(10.0 ** -k for k in range(1, 9))
+FRACTIONS = (0.5,) + tuple(10.0**-k for k in range(1, 9))
 QUICK_FRACTIONS = (0.5, 1e-2, 1e-4, 1e-6, 1e-8)
 GAMMAS = (0.0, 0.1)
 SINGULAR = 1e-14  # lambda_min / lambda_max below this: numerically singular
@@ -78,22 +78,37 @@ def floats(name, lo, hi, lo_open=False):
         if not vals:
             raise ValueError
         return vals
+
     parse.__name__ = name
     return parse
 
 
 def parse(argv):
     p = DemoParser(prog="small_cuts.py", description=__doc__.split("\n\n")[0])
-    p.add_argument("--out-dir", default=str(ROOT / "benchmarks" / "results"),
-                   help="folder of small_cuts.json and .png (default benchmarks/results)")
+    p.add_argument(
+        "--out-dir",
+        default=str(ROOT / "benchmarks" / "results"),
+        help="folder of small_cuts.json and .png (default benchmarks/results)",
+    )
     p.add_argument("--n", type=int, default=5, help="cells over the height, in [3, 40]")
-    p.add_argument("--fractions", type=floats("--fractions", 0, 0.5, lo_open=True),
-                   default=None, help="cut fractions eta in (0, 0.5] (default 0.5,1e-1,...,"
-                                      "1e-8; 0.5, the reference of the ratios, is always added)")
-    p.add_argument("--gammas", type=floats("--gammas", 0, None), default=None,
-                   help="ghost-penalty factors (default 0,0.1)")
-    p.add_argument("--quick", action="store_true",
-                   help=f"fractions {','.join(f'{f:g}' for f in QUICK_FRACTIONS)} only")
+    p.add_argument(
+        "--fractions",
+        type=floats("--fractions", 0, 0.5, lo_open=True),
+        default=None,
+        help="cut fractions eta in (0, 0.5] (default 0.5,1e-1,...,"
+        "1e-8; 0.5, the reference of the ratios, is always added)",
+    )
+    p.add_argument(
+        "--gammas",
+        type=floats("--gammas", 0, None),
+        default=None,
+        help="ghost-penalty factors (default 0,0.1)",
+    )
+    p.add_argument(
+        "--quick",
+        action="store_true",
+        help=f"fractions {','.join(f'{f:g}' for f in QUICK_FRACTIONS)} only",
+    )
     a = p.parse_args(argv)
     if not 3 <= a.n <= 40:
         p.error(f"--n: must be in [3, 40] (dense SVD), got {a.n}")
@@ -106,8 +121,10 @@ def parse(argv):
     # patch_cut_scene rejects an interface within 1e-9 cells of a grid line
     small = [f for f in a.fractions if f < 2e-9]
     if small:
-        p.error(f"--fractions: {small[0]:g} is below 2e-9 (patch_cut_scene needs the interface "
-                f"off the grid lines by more than 1e-9 cells)")
+        p.error(
+            f"--fractions: {small[0]:g} is below 2e-9 (patch_cut_scene needs the interface "
+            f"off the grid lines by more than 1e-9 cells)"
+        )
     return a
 
 
@@ -122,9 +139,16 @@ def interface_height(n, eta, tiny="lower"):
 def patch_problem(n, interface, gamma, eps0=EPS0, comm=MPI.COMM_WORLD):
     """(scene, ContactProblem) of the cut patch test."""
     scene = patch_cut_scene(comm, n=n, width=WIDTH, height=HEIGHT, interface=interface)
-    problem = ContactProblem(scene, {b.tag: (E, NU) for b in scene.bodies}, mu=0.0, eps0=eps0,
-                             band=0.5 * HEIGHT / n, ghost_penalty=gamma, dirichlet=patch_dirichlet(D, HEIGHT),
-                             log=lambda *a, **k: None)
+    problem = ContactProblem(
+        scene,
+        {b.tag: (E, NU) for b in scene.bodies},
+        mu=0.0,
+        eps0=eps0,
+        band=0.5 * HEIGHT / n,
+        ghost_penalty=gamma,
+        dirichlet=patch_dirichlet(D, HEIGHT),
+        log=lambda *a, **k: None,
+    )
     return scene, problem
 
 
@@ -163,12 +187,18 @@ def with_identity(A, dofs):
 def spectrum(A):
     """cond (dense SVD: sigma_max / sigma_min), and for a symmetric A its extreme eigenvalues."""
     s = np.linalg.svd(A, compute_uv=False)
-    out = dict(cond=float(s[0] / s[-1]) if s[-1] > 0 else float("inf"),
-               sigma_min=float(s[-1]), sigma_max=float(s[0]))
+    out = dict(
+        cond=float(s[0] / s[-1]) if s[-1] > 0 else float("inf"),
+        sigma_min=float(s[-1]),
+        sigma_max=float(s[0]),
+    )
     if np.allclose(A, A.T, rtol=0, atol=1e-12 * s[0]):
         lam = np.linalg.eigvalsh(0.5 * (A + A.T))
-        out.update(lambda_min=float(lam[0]), lambda_max=float(lam[-1]),
-                   singular=bool(lam[0] <= SINGULAR * lam[-1]))
+        out.update(
+            lambda_min=float(lam[0]),
+            lambda_max=float(lam[-1]),
+            singular=bool(lam[0] <= SINGULAR * lam[-1]),
+        )
     return out
 
 
@@ -210,13 +240,24 @@ def run_case(n, eta, gamma, tiny="lower", eps0=EPS0):
     interface = interface_height(n, eta, tiny)
     scene, problem = patch_problem(n, interface, gamma, eps0)
     x, upper, phi = dof_data(scene, problem)
-    rec = dict(n=n, eta=eta, gamma=gamma, tiny=tiny, interface=interface,
-               eta_actual=actual_fraction(n, interface, x, upper, phi, tiny),
-               num_dofs=int(problem.num_dofs), num_bc_dofs=int(len(problem.bc_owned)),
-               eps_n=problem.eps_n)
+    rec = dict(
+        n=n,
+        eta=eta,
+        gamma=gamma,
+        tiny=tiny,
+        interface=interface,
+        eta_actual=actual_fraction(n, interface, x, upper, phi, tiny),
+        num_dofs=int(problem.num_dofs),
+        num_bc_dofs=int(len(problem.bc_owned)),
+        eps_n=problem.eps_n,
+    )
     K = stiffness_spectrum(problem)
-    rec.update(cond_K=K["cond"], lambda_min=K["lambda_min"], lambda_max=K["lambda_max"],
-               K_singular=K["singular"])
+    rec.update(
+        cond_K=K["cond"],
+        lambda_min=K["lambda_min"],
+        lambda_max=K["lambda_max"],
+        K_singular=K["singular"],
+    )
     try:
         problem.solve(1, label=f"eta={eta:g} gamma={gamma:g}")
         rec.update(failed=False, error=None, newton_iterations=problem.steps[-1].iterations)
@@ -243,8 +284,13 @@ def run_case(n, eta, gamma, tiny="lower", eps0=EPS0):
 
 def run_all(n, fractions, gammas, mirrored=True):
     tinies = ("lower", "upper") if mirrored else ("lower",)
-    return [run_case(n, eta, gamma, tiny) for gamma in gammas for tiny in tinies
-            for eta in fractions if not (tiny == "upper" and eta == 0.5)]
+    return [
+        run_case(n, eta, gamma, tiny)
+        for gamma in gammas
+        for tiny in tinies
+        for eta in fractions
+        if not (tiny == "upper" and eta == 0.5)
+    ]
 
 
 def growth(records):
@@ -253,33 +299,69 @@ def growth(records):
     ref = {(r["gamma"]): r["cond_K"] for r in records if r["eta"] == 0.5 and r["tiny"] == "lower"}
     for g in sorted({r["gamma"] for r in records}):
         for tiny in ("lower", "upper"):
-            rs = sorted((r for r in records if r["gamma"] == g and
-                         (r["tiny"] == tiny or r["eta"] == 0.5)), key=lambda r: -r["eta"])
+            rs = sorted(
+                (r for r in records if r["gamma"] == g and (r["tiny"] == tiny or r["eta"] == 0.5)),
+                key=lambda r: -r["eta"],
+            )
             if len(rs) < 2 or g not in ref:
                 continue
             e = np.array([r["eta"] for r in rs])
             c = np.array([r["cond_K"] for r in rs])
             small = e <= 1e-2
-            slope = (float(-np.polyfit(np.log(e[small]), np.log(c[small]), 1)[0])
-                     if small.sum() >= 2 else None)
-            out.append(dict(gamma=g, tiny=tiny, exponent_small_eta=slope,
-                            max_ratio_to_eta_half=float(c.max() / ref[g])))
+            slope = (
+                float(-np.polyfit(np.log(e[small]), np.log(c[small]), 1)[0])
+                if small.sum() >= 2
+                else None
+            )
+            out.append(
+                dict(
+                    gamma=g,
+                    tiny=tiny,
+                    exponent_small_eta=slope,
+                    max_ratio_to_eta_half=float(c.max() / ref[g]),
+                )
+            )
     return out
 
 
 # --------------------------------------------------------------------------- output
-COLUMNS = [("eta", "{:8.0e}"), ("gamma", "{:5g}"), ("tiny", "{:>5s}"), ("cond_K", "{:9.2e}"),
-           ("lambda_min", "{:10.2e}"), ("lambda_max", "{:10.2e}"), ("cond_J", "{:9.2e}"),
-           ("newton_iterations", "{:3d}"), ("pressure_max_rel_deviation", "{:9.1e}"),
-           ("reaction_rel_error", "{:9.1e}"), ("u_error_physical", "{:9.1e}"),
-           ("u_error_all", "{:9.1e}"), ("time_s", "{:6.3f}")]
-HEADERS = ["eta", "gamma", "tiny", "cond(K)", "lam_min", "lam_max", "cond(J)", "its", "dp/p",
-           "dR/R", "du phys", "du all", "t (s)"]
+COLUMNS = [
+    ("eta", "{:8.0e}"),
+    ("gamma", "{:5g}"),
+    ("tiny", "{:>5s}"),
+    ("cond_K", "{:9.2e}"),
+    ("lambda_min", "{:10.2e}"),
+    ("lambda_max", "{:10.2e}"),
+    ("cond_J", "{:9.2e}"),
+    ("newton_iterations", "{:3d}"),
+    ("pressure_max_rel_deviation", "{:9.1e}"),
+    ("reaction_rel_error", "{:9.1e}"),
+    ("u_error_physical", "{:9.1e}"),
+    ("u_error_all", "{:9.1e}"),
+    ("time_s", "{:6.3f}"),
+]
+HEADERS = [
+    "eta",
+    "gamma",
+    "tiny",
+    "cond(K)",
+    "lam_min",
+    "lam_max",
+    "cond(J)",
+    "its",
+    "dp/p",
+    "dR/R",
+    "du phys",
+    "du all",
+    "t (s)",
+]
 
 
 def table(records):
-    widths = [max(len(h), len(fmt.format(1e-8) if "e" in fmt else h)) for h, (_, fmt) in
-              zip(HEADERS, COLUMNS)]
+    widths = [
+        max(len(h), len(fmt.format(1e-8) if "e" in fmt else h))
+        for h, (_, fmt) in zip(HEADERS, COLUMNS)
+    ]
     lines = ["  ".join(h.rjust(w) for h, w in zip(HEADERS, widths))]
     for r in records:
         cells = []
@@ -292,6 +374,7 @@ def table(records):
 
 def plot(path, records):
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
@@ -300,32 +383,54 @@ def plot(path, records):
     colors = {g: f"C{i}" for i, g in enumerate(gammas)}
 
     def series(g, tiny, key):
-        rs = sorted((r for r in records if r["gamma"] == g and not r["failed"] and
-                     (r["tiny"] == tiny or r["eta"] == 0.5)), key=lambda r: r["eta"])
+        rs = sorted(
+            (
+                r
+                for r in records
+                if r["gamma"] == g and not r["failed"] and (r["tiny"] == tiny or r["eta"] == 0.5)
+            ),
+            key=lambda r: r["eta"],
+        )
         return [r["eta"] for r in rs], [max(r[key], 1e-17) for r in rs]
 
-    left = [("cond_K", "lower", "-o", "cond(K), eta in the lower body"),
-            ("cond_K", "upper", "--s", "cond(K), eta in the upper body"),
-            ("cond_J", "lower", ":^", "cond(J) at the solution, eta in the lower body")]
-    right = [("u_error_physical", "-o", "u at physical nodes"),
-             ("u_error_all", ":^", "u at all nodes (incl. fictitious)"),
-             ("pressure_max_rel_deviation", "--x", "contact pressure vs penalised exact")]
+    left = [
+        ("cond_K", "lower", "-o", "cond(K), eta in the lower body"),
+        ("cond_K", "upper", "--s", "cond(K), eta in the upper body"),
+        ("cond_J", "lower", ":^", "cond(J) at the solution, eta in the lower body"),
+    ]
+    right = [
+        ("u_error_physical", "-o", "u at physical nodes"),
+        ("u_error_all", ":^", "u at all nodes (incl. fictitious)"),
+        ("pressure_max_rel_deviation", "--x", "contact pressure vs penalised exact"),
+    ]
     for g in gammas:
         for key, tiny, style, lab in left:
-            ax0.loglog(*series(g, tiny, key), style, color=colors[g], ms=4,
-                       label=f"gamma={g:g}: {lab}")
+            ax0.loglog(
+                *series(g, tiny, key), style, color=colors[g], ms=4, label=f"gamma={g:g}: {lab}"
+            )
         for key, style, lab in right:
             for i, tiny in enumerate(("lower", "upper")):  # both bodies, one legend entry
-                ax1.loglog(*series(g, tiny, key), style, color=colors[g], ms=4,
-                           alpha=1.0 if i == 0 else 0.5,
-                           label=f"gamma={g:g}: {lab}" if i == 0 else None)
+                ax1.loglog(
+                    *series(g, tiny, key),
+                    style,
+                    color=colors[g],
+                    ms=4,
+                    alpha=1.0 if i == 0 else 0.5,
+                    label=f"gamma={g:g}: {lab}" if i == 0 else None,
+                )
     e = np.array(sorted({r["eta"] for r in records}))
     ref = min(r["cond_K"] for r in records if r["eta"] == 0.5)
     ax0.loglog(e, ref * 0.5 / e, ":", color="gray", label="~ 1/eta")
-    ax0.set(xlabel="cut fraction eta", ylabel="condition number (Dirichlet dofs -> identity)",
-            title=f"n = {records[0]['n']}: stiffness K and contact Jacobian J")
-    ax1.set(xlabel="cut fraction eta", ylabel="max relative error",
-            title="patch test errors (faint: eta in the upper body)")
+    ax0.set(
+        xlabel="cut fraction eta",
+        ylabel="condition number (Dirichlet dofs -> identity)",
+        title=f"n = {records[0]['n']}: stiffness K and contact Jacobian J",
+    )
+    ax1.set(
+        xlabel="cut fraction eta",
+        ylabel="max relative error",
+        title="patch test errors (faint: eta in the upper body)",
+    )
     for ax in (ax0, ax1):
         ax.invert_xaxis()
         ax.grid(True, which="both", alpha=0.3)
@@ -342,12 +447,26 @@ def main(argv=None):
         return 2
     t0 = time.perf_counter()
     records = run_all(args.n, args.fractions, args.gammas)
-    data = dict(benchmark="small_cuts", git=git_head(),
-                parameters=dict(n=args.n, row=args.n // 2, E=E, nu=NU, d=D, eps0=EPS0,
-                                width=WIDTH, height=HEIGHT, fractions=args.fractions,
-                                gammas=args.gammas, quick=args.quick),
-                growth=growth(records), records=records,
-                total_time_s=time.perf_counter() - t0)
+    data = dict(
+        benchmark="small_cuts",
+        git=git_head(),
+        parameters=dict(
+            n=args.n,
+            row=args.n // 2,
+            E=E,
+            nu=NU,
+            d=D,
+            eps0=EPS0,
+            width=WIDTH,
+            height=HEIGHT,
+            fractions=args.fractions,
+            gammas=args.gammas,
+            quick=args.quick,
+        ),
+        growth=growth(records),
+        records=records,
+        total_time_s=time.perf_counter() - t0,
+    )
     out = Path(args.out_dir)
     out.mkdir(parents=True, exist_ok=True)
     json_path, png_path = out / "small_cuts.json", out / "small_cuts.png"
@@ -355,14 +474,17 @@ def main(argv=None):
     def write_json(tmp):
         with open(tmp, "w") as f:
             json.dump(data, f, indent=2)
+
     write_atomic(json_path, write_json)
     plot(png_path, records)
     print(table(records))
     for g in data["growth"]:
         s = g["exponent_small_eta"]
-        print(f"gamma={g['gamma']:g}, eta in {g['tiny']} body: cond_K ~ eta^-"
-              f"{'n/a' if s is None else f'{s:.2f}'}, max cond_K / cond_K(0.5) = "
-              f"{g['max_ratio_to_eta_half']:.3g}")
+        print(
+            f"gamma={g['gamma']:g}, eta in {g['tiny']} body: cond_K ~ eta^-"
+            f"{'n/a' if s is None else f'{s:.2f}'}, max cond_K / cond_K(0.5) = "
+            f"{g['max_ratio_to_eta_half']:.3g}"
+        )
     print(f"results in {json_path.resolve()} and {png_path.resolve()}")
     return 0
 

@@ -72,23 +72,39 @@ TARGET = 0.02  # pressure L2 error of the time-to-precision figure
 
 def parse(argv):
     p = DemoParser(prog="work_precision.py", description=__doc__.split("\n\n")[0])
-    p.add_argument("--quick", action="store_true",
-                   help=f"smoke test: 3 coarse sizes (a/10, a/14, a/20), variants "
-                        f"{QUICK_VARIANTS} unless --variants is given")
-    p.add_argument("--variants", default=None,
-                   help=f"comma-separated subset of {','.join(VARIANTS)} "
-                        f"(default {DEFAULT_VARIANTS})")
-    p.add_argument("--out-dir", default=str(ROOT / "benchmarks" / "results"),
-                   help="folder of work_precision.json and .png (default benchmarks/results)")
-    p.add_argument("--timeout", type=float, default=3600.0,
-                   help="seconds before one demo run is killed and recorded as failed")
+    p.add_argument(
+        "--quick",
+        action="store_true",
+        help=f"smoke test: 3 coarse sizes (a/10, a/14, a/20), variants "
+        f"{QUICK_VARIANTS} unless --variants is given",
+    )
+    p.add_argument(
+        "--variants",
+        default=None,
+        help=f"comma-separated subset of {','.join(VARIANTS)} " f"(default {DEFAULT_VARIANTS})",
+    )
+    p.add_argument(
+        "--out-dir",
+        default=str(ROOT / "benchmarks" / "results"),
+        help="folder of work_precision.json and .png (default benchmarks/results)",
+    )
+    p.add_argument(
+        "--timeout",
+        type=float,
+        default=3600.0,
+        help="seconds before one demo run is killed and recorded as failed",
+    )
     a = p.parse_args(argv)
-    names = [v.strip() for v in
-             (a.variants or (QUICK_VARIANTS if a.quick else DEFAULT_VARIANTS)).split(",")]
+    names = [
+        v.strip()
+        for v in (a.variants or (QUICK_VARIANTS if a.quick else DEFAULT_VARIANTS)).split(",")
+    ]
     bad = [v for v in names if v not in VARIANTS]
     if bad or not names:
-        p.error(f"--variants: unknown variant {bad[0] if bad else ''!r}; "
-                f"choose from {','.join(VARIANTS)}")
+        p.error(
+            f"--variants: unknown variant {bad[0] if bad else ''!r}; "
+            f"choose from {','.join(VARIANTS)}"
+        )
     if len(set(names)) != len(names):
         p.error("--variants: a variant is listed twice")
     if not (math.isfinite(a.timeout) and a.timeout > 0):
@@ -102,9 +118,13 @@ def code_digest():
     """sha256 (12 hex) over the sources the demo runs (demo and its runner, package, meshes,
     compiled core):
     others may edit the repository while the benchmark runs; a change shows up per run."""
-    files = [DEMO, Path(study.__file__), *sorted((ROOT / "dolfinx_forms").glob("*.py")),
-             *sorted((ROOT / "dolfinx_forms").glob("_cpp*.so")),
-             *sorted((ROOT / "meshes").glob("*.py"))]
+    files = [
+        DEMO,
+        Path(study.__file__),
+        *sorted((ROOT / "dolfinx_forms").glob("*.py")),
+        *sorted((ROOT / "dolfinx_forms").glob("_cpp*.so")),
+        *sorted((ROOT / "meshes").glob("*.py")),
+    ]
     h = hashlib.sha256()
     for f in files:
         h.update(str(f.relative_to(ROOT)).encode())
@@ -114,12 +134,20 @@ def code_digest():
 
 def git_head():
     try:
-        r = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True,
-                           timeout=30)
-        d = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
-                           capture_output=True, text=True, timeout=30)
-        return dict(commit=r.stdout.strip() or None,
-                    modified=[ln[3:] for ln in d.stdout.splitlines() if ln.strip()])
+        r = subprocess.run(
+            ["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True, timeout=30
+        )
+        d = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no"],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            timeout=30,
+        )
+        return dict(
+            commit=r.stdout.strip() or None,
+            modified=[ln[3:] for ln in d.stdout.splitlines() if ln.strip()],
+        )
     except (OSError, subprocess.SubprocessError):
         return dict(commit=None, modified=None)
 
@@ -130,8 +158,13 @@ def hertz_half_width():
 
 def run_one(variant, divisor, h, timeout):
     """One demo run in a scratch folder; returns the run record (ok or failed)."""
-    rec = dict(variant=variant, path=study.variant_path(variant), h_divisor=divisor, h=h,
-               code_sha256=code_digest())
+    rec = dict(
+        variant=variant,
+        path=study.variant_path(variant),
+        h_divisor=divisor,
+        h=h,
+        code_sha256=code_digest(),
+    )
     rec.update(study.run_hertz(h, VARIANTS[variant], timeout))
     return rec
 
@@ -148,17 +181,25 @@ def time_to_target(runs, target=TARGET):
     t = [r["timing_s"]["total"] for r in ok]
     n = [r["num_dofs"] for r in ok]
     if e[0] <= target:
-        out.update(reached=True, time_s=t[0], num_dofs=n[0],
-                   method="upper bound: the fastest run is already at or below the target")
+        out.update(
+            reached=True,
+            time_s=t[0],
+            num_dofs=n[0],
+            method="upper bound: the fastest run is already at or below the target",
+        )
         return out
     for i in range(len(ok) - 1):
         if e[i] > target >= e[i + 1]:
             s = (math.log(target) - math.log(e[i])) / (math.log(e[i + 1]) - math.log(e[i]))
             ti = math.exp(math.log(t[i]) + s * (math.log(t[i + 1]) - math.log(t[i])))
             ni = math.exp(math.log(n[i]) + s * (math.log(n[i + 1]) - math.log(n[i])))
-            out.update(reached=True, time_s=ti, num_dofs=ni,
-                       method=f"log-log interpolation between h = {ok[i]['h']:.4g} and "
-                              f"h = {ok[i + 1]['h']:.4g}")
+            out.update(
+                reached=True,
+                time_s=ti,
+                num_dofs=ni,
+                method=f"log-log interpolation between h = {ok[i]['h']:.4g} and "
+                f"h = {ok[i + 1]['h']:.4g}",
+            )
             return out
     out["method"] = f"not reached (smallest error {min(e):.4g})"
     return out
@@ -173,21 +214,29 @@ def summarize(variant, runs):
         errs = [r["errors"][k] for r in ok_h]
         rates[k] = loglog_rate(hs, errs)
         monotone[k] = study.decreasing(errs)
-    return dict(variant=variant, path=study.variant_path(variant), runs_ok=len(ok),
-                runs_failed=len(runs) - len(ok),
-                rates_vs_h=rates,
-                rate_pressure_l2_vs_dofs=loglog_rate([r["num_dofs"] for r in ok_h],
-                                                      [r["errors"]["pressure_rel_l2_error"]
-                                                       for r in ok_h]),
-                errors_decrease_monotonically=monotone,
-                time_to_target=time_to_target(ok))
+    return dict(
+        variant=variant,
+        path=study.variant_path(variant),
+        runs_ok=len(ok),
+        runs_failed=len(runs) - len(ok),
+        rates_vs_h=rates,
+        rate_pressure_l2_vs_dofs=loglog_rate(
+            [r["num_dofs"] for r in ok_h], [r["errors"]["pressure_rel_l2_error"] for r in ok_h]
+        ),
+        errors_decrease_monotonically=monotone,
+        time_to_target=time_to_target(ok),
+    )
 
 
 def compare_paths(summary):
     """Time (and dofs) to TARGET of the cut variant(s) beside the fastest conforming variant."""
+
     def best(path):
-        got = [(s["time_to_target"]["time_s"], v) for v, s in summary.items()
-               if s["path"] == path and s["time_to_target"]["reached"]]
+        got = [
+            (s["time_to_target"]["time_s"], v)
+            for v, s in summary.items()
+            if s["path"] == path and s["time_to_target"]["reached"]
+        ]
         return min(got) if got else (None, None)
 
     (t_c, v_c), (t_x, v_x) = best("conforming"), best("cut")
@@ -195,14 +244,17 @@ def compare_paths(summary):
         target=TARGET,
         time_to_target_s={v: s["time_to_target"]["time_s"] for v, s in summary.items()},
         dofs_at_target={v: s["time_to_target"]["num_dofs"] for v, s in summary.items()},
-        rate_pressure_l2_vs_h={v: s["rates_vs_h"]["pressure_rel_l2_error"]
-                               for v, s in summary.items()},
-        fastest_conforming=v_c, fastest_cut=v_x,
+        rate_pressure_l2_vs_h={
+            v: s["rates_vs_h"]["pressure_rel_l2_error"] for v, s in summary.items()
+        },
+        fastest_conforming=v_c,
+        fastest_cut=v_x,
         cut_over_conforming_time=(t_x / t_c if t_c and t_x else None),
         definition="time_to_target_s: the demo's total time at which the pressure L2 error "
-                   "reaches the target (log-log interpolation, see summary.*.time_to_target); "
-                   "cut_over_conforming_time: fastest cut / fastest conforming (< 1: the cut "
-                   "path is faster)")
+        "reaches the target (log-log interpolation, see summary.*.time_to_target); "
+        "cut_over_conforming_time: fastest cut / fastest conforming (< 1: the cut "
+        "path is faster)",
+    )
 
 
 def write_atomic(path, writer):
@@ -229,13 +281,24 @@ def write_json(path, data):
             f.write("\n")
             f.flush()
             os.fsync(f.fileno())
+
     write_atomic(path, writer)
 
 
-COLORS = {"p1-tri": "tab:blue", "p2-tri": "tab:orange", "p1-quad": "tab:green",
-          "p2-quad": "tab:red", "q1-cut": "tab:purple"}
-PHASE_COLORS = {"mesh": "tab:gray", "assembly": "tab:blue", "contact": "tab:orange",
-                "solve": "tab:green", "other": "whitesmoke"}
+COLORS = {
+    "p1-tri": "tab:blue",
+    "p2-tri": "tab:orange",
+    "p1-quad": "tab:green",
+    "p2-quad": "tab:red",
+    "q1-cut": "tab:purple",
+}
+PHASE_COLORS = {
+    "mesh": "tab:gray",
+    "assembly": "tab:blue",
+    "contact": "tab:orange",
+    "solve": "tab:green",
+    "other": "whitesmoke",
+}
 
 
 def plain_log_labels(ax):
@@ -252,6 +315,7 @@ def plain_log_labels(ax):
 
 def plot(path, data):
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
@@ -266,14 +330,21 @@ def plot(path, data):
             continue
         e = [100 * r["errors"]["pressure_rel_l2_error"] for r in ok]
         rate = data["summary"][v]["rates_vs_h"]["pressure_rel_l2_error"]
-        label = (f"{v} ({'cut' if study.variant_path(v) == 'cut' else 'gmsh'})"
-                 + (f", rate {rate:.2f} in h" if rate is not None else ""))
+        label = f"{v} ({'cut' if study.variant_path(v) == 'cut' else 'gmsh'})" + (
+            f", rate {rate:.2f} in h" if rate is not None else ""
+        )
         c, style = COLORS.get(v), "s--" if study.variant_path(v) == "cut" else "o-"
         ax_t.loglog([r["timing_s"]["total"] for r in ok], e, style, color=c, label=label)
         ax_n.loglog([r["num_dofs"] for r in ok], e, style, color=c, label=label)
         for r, ei in zip(ok, e):
-            ax_n.annotate(f"a/{r['h_divisor']}", (r["num_dofs"], ei), fontsize=7,
-                          xytext=(3, 3), textcoords="offset points", color=c)
+            ax_n.annotate(
+                f"a/{r['h_divisor']}",
+                (r["num_dofs"], ei),
+                fontsize=7,
+                xytext=(3, 3),
+                textcoords="offset points",
+                color=c,
+            )
         tt = data["summary"][v]["time_to_target"]
         if tt["reached"]:
             ax_t.plot(tt["time_s"], 100 * TARGET, "*", ms=12, color=c, mec="k", mew=0.5)
@@ -303,14 +374,22 @@ def plot(path, data):
                 parts = [(k, ts[k]) for k in PHASES]
                 parts.append(("other", max(0.0, ts["total"] - sum(ts[k] for k in PHASES))))
                 for k, val in parts:
-                    ax_s.bar(x, val, bottom=b, color=PHASE_COLORS[k], edgecolor="k", lw=0.3,
-                             label=k if k not in bottoms_seen else None)
+                    ax_s.bar(
+                        x,
+                        val,
+                        bottom=b,
+                        color=PHASE_COLORS[k],
+                        edgecolor="k",
+                        lw=0.3,
+                        label=k if k not in bottoms_seen else None,
+                    )
                     bottoms_seen.add(k)
                     b += val
                 ax_s.text(x, b, f"{b:.1f}", ha="center", va="bottom", fontsize=7)
             else:
-                ax_s.text(x, 0, "failed", ha="center", va="bottom", rotation=90, color="r",
-                          fontsize=8)
+                ax_s.text(
+                    x, 0, "failed", ha="center", va="bottom", rotation=90, color="r", fontsize=8
+                )
             x += 1.0
         x += 0.8
     ax_s.set_xticks(pos)
@@ -321,8 +400,11 @@ def plot(path, data):
     if bottoms_seen:
         ax_s.legend(fontsize=8, ncol=5, loc="upper left")
     ax_s.grid(True, axis="y", lw=0.3)
-    fig.suptitle(f"Hertz line contact, frictionless: work-precision "
-                 f"(a = {data['a_hertz']:.4g} mm, h = a/k)", fontsize=11)
+    fig.suptitle(
+        f"Hertz line contact, frictionless: work-precision "
+        f"(a = {data['a_hertz']:.4g} mm, h = a/k)",
+        fontsize=11,
+    )
     fig.tight_layout()
     write_atomic(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
     plt.close(fig)
@@ -333,35 +415,45 @@ def fmt(x, spec):
 
 
 def report(data):
-    print(f"{'variant':8} {'h':>7} {'dofs':>8} {'total s':>8} {'solve s':>8} {'Newton':>6} "
-          f"{'|a-aH|/aH':>10} {'|p0-pH|/pH':>10} {'p L2 err':>9}")
+    print(
+        f"{'variant':8} {'h':>7} {'dofs':>8} {'total s':>8} {'solve s':>8} {'Newton':>6} "
+        f"{'|a-aH|/aH':>10} {'|p0-pH|/pH':>10} {'p L2 err':>9}"
+    )
     for r in data["runs"]:
         if not r["ok"]:
             print(f"{r['variant']:8} {r['h']:7.4f}  FAILED: {r['error']}")
             continue
         e = r["errors"]
-        print(f"{r['variant']:8} {r['h']:7.4f} {r['num_dofs']:8d} {r['timing_s']['total']:8.2f} "
-              f"{r['timing_s']['solve']:8.2f} {r['newton_iterations_total']:6d} "
-              f"{e['half_width_rel_error']:10.3%} {e['peak_pressure_rel_error']:10.3%} "
-              f"{e['pressure_rel_l2_error']:9.3%}")
+        print(
+            f"{r['variant']:8} {r['h']:7.4f} {r['num_dofs']:8d} {r['timing_s']['total']:8.2f} "
+            f"{r['timing_s']['solve']:8.2f} {r['newton_iterations_total']:6d} "
+            f"{e['half_width_rel_error']:10.3%} {e['peak_pressure_rel_error']:10.3%} "
+            f"{e['pressure_rel_l2_error']:9.3%}"
+        )
     for v, s in data["summary"].items():
         rt = s["rates_vs_h"]
         tt = s["time_to_target"]
-        print(f"{v}: rates vs h: a {fmt(rt['half_width_rel_error'], '.2f')}, "
-              f"p0 {fmt(rt['peak_pressure_rel_error'], '.2f')}, "
-              f"p L2 {fmt(rt['pressure_rel_l2_error'], '.2f')}; "
-              f"time to {100 * TARGET:g} %: "
-              + (f"{tt['time_s']:.2f} s ({tt['method']})" if tt["reached"] else tt["method"]))
+        print(
+            f"{v}: rates vs h: a {fmt(rt['half_width_rel_error'], '.2f')}, "
+            f"p0 {fmt(rt['peak_pressure_rel_error'], '.2f')}, "
+            f"p L2 {fmt(rt['pressure_rel_l2_error'], '.2f')}; "
+            f"time to {100 * TARGET:g} %: "
+            + (f"{tt['time_s']:.2f} s ({tt['method']})" if tt["reached"] else tt["method"])
+        )
     c = data["cut_vs_conforming"]
     print(f"time to {100 * TARGET:g} % pressure L2 error, gmsh vs cut path:")
     print(f"  {'variant':8} {'path':10} {'rate in h':>9} {'time s':>8} {'dofs':>8}")
     for v, s in data["summary"].items():
         tt = s["time_to_target"]
-        print(f"  {v:8} {s['path']:10} {fmt(s['rates_vs_h']['pressure_rel_l2_error'], '9.2f'):>9} "
-              f"{fmt(tt['time_s'], '8.2f'):>8} {fmt(tt['num_dofs'], '8.0f'):>8}")
+        print(
+            f"  {v:8} {s['path']:10} {fmt(s['rates_vs_h']['pressure_rel_l2_error'], '9.2f'):>9} "
+            f"{fmt(tt['time_s'], '8.2f'):>8} {fmt(tt['num_dofs'], '8.0f'):>8}"
+        )
     if c["cut_over_conforming_time"] is not None:
-        print(f"  {c['fastest_cut']} / {c['fastest_conforming']}: "
-              f"{c['cut_over_conforming_time']:.2f} x the time")
+        print(
+            f"  {c['fastest_cut']} / {c['fastest_conforming']}: "
+            f"{c['cut_over_conforming_time']:.2f} x the time"
+        )
 
 
 def main(argv=None):
@@ -383,26 +475,36 @@ def main(argv=None):
             rec = run_one(v, k, h, args.timeout)
             runs.append(rec)
             if rec["ok"]:
-                print(f"    {rec['num_dofs']} dofs, {rec['timing_s']['total']:.2f} s, "
-                      f"p L2 error {rec['errors']['pressure_rel_l2_error']:.3%}", flush=True)
+                print(
+                    f"    {rec['num_dofs']} dofs, {rec['timing_s']['total']:.2f} s, "
+                    f"p L2 error {rec['errors']['pressure_rel_l2_error']:.3%}",
+                    flush=True,
+                )
             else:
                 print(f"    FAILED: {rec['error']}", flush=True)
     data = dict(
         benchmark="hertz work-precision (frictionless, demos/hertz.py defaults)",
-        a_hertz=a, hertz_defaults=HERTZ_DEFAULTS, h_divisors=list(args.divisors),
-        variants=args.variants, variant_args={v: VARIANTS[v] for v in args.variants},
-        quick=args.quick, python=sys.executable, git=git,
+        a_hertz=a,
+        hertz_defaults=HERTZ_DEFAULTS,
+        h_divisors=list(args.divisors),
+        variants=args.variants,
+        variant_args={v: VARIANTS[v] for v in args.variants},
+        quick=args.quick,
+        python=sys.executable,
+        git=git,
         code_sha256=sorted({r["code_sha256"] for r in runs}),
         code_changed_during_benchmark=len({r["code_sha256"] for r in runs}) > 1,
-        load_average_at_start=load0, cpu_count=os.cpu_count(),
+        load_average_at_start=load0,
+        cpu_count=os.cpu_count(),
         errors_definition=dict(
             half_width_rel_error="|a - a_H| / a_H, a_H Hertz at the computed load",
             peak_pressure_rel_error="|p0 - p0_H| / p0_H, p0_H Hertz at the computed load",
-            pressure_rel_l2_error="results.pressure_rel_l2_error of metrics.json"),
+            pressure_rel_l2_error="results.pressure_rel_l2_error of metrics.json",
+        ),
         rates_definition="least-squares slope of log(error) vs log(h) over the successful runs "
-                         "(positive: converging); rate_pressure_l2_vs_dofs: slope vs num_dofs",
+        "(positive: converging); rate_pressure_l2_vs_dofs: slope vs num_dofs",
         timing_definition="timing_s: the demo's phase timer (total excludes interpreter start-up "
-                          "and file output); wall_s: the subprocess wall time",
+        "and file output); wall_s: the subprocess wall time",
         runs=runs,
         summary={v: summarize(v, [r for r in runs if r["variant"] == v]) for v in args.variants},
     )
@@ -412,8 +514,10 @@ def main(argv=None):
     plot(png_path, data)
     report(data)
     if data["code_changed_during_benchmark"]:
-        print("warning: the demo/package sources changed during the benchmark "
-              f"(digests {', '.join(data['code_sha256'])}); runs are not comparable")
+        print(
+            "warning: the demo/package sources changed during the benchmark "
+            f"(digests {', '.join(data['code_sha256'])}); runs are not comparable"
+        )
     print(f"results in {json_path.resolve()} and {png_path.resolve()}")
     return 0
 

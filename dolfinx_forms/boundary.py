@@ -75,15 +75,20 @@ def dirichlet_dofs(V, scene, condition):
     gdim = V.mesh.geometry.dim
     comps = list(range(gdim)) if condition.component is None else [condition.component]
     if callable(condition.boundary):
-        dofs = [fem.locate_dofs_geometrical((V.sub(c), V.sub(c).collapse()[0]),
-                                            condition.boundary)[0] for c in comps]
+        dofs = [
+            fem.locate_dofs_geometrical((V.sub(c), V.sub(c).collapse()[0]), condition.boundary)[0]
+            for c in comps
+        ]
     else:
         if condition.boundary not in scene.boundaries:
-            raise ValueError(f"Dirichlet: unknown boundary {condition.boundary!r}; the scene has "
-                             f"{sorted(scene.boundaries)}")
+            raise ValueError(
+                f"Dirichlet: unknown boundary {condition.boundary!r}; the scene has "
+                f"{sorted(scene.boundaries)}"
+            )
         facets = scene.facet_tags.find(scene.boundaries[condition.boundary])
-        dofs = [fem.locate_dofs_topological(V.sub(c), V.mesh.topology.dim - 1, facets)
-                for c in comps]
+        dofs = [
+            fem.locate_dofs_topological(V.sub(c), V.mesh.topology.dim - 1, facets) for c in comps
+        ]
     return np.concatenate(dofs).astype(np.int32)
 
 

@@ -22,8 +22,18 @@ class BulkForms:
     quadrature_degree: FFCx degree on body-fitted cells and interior cut cells (None: FFCx's
     estimate for linear laws, 2 p for nonlinear ones)."""
 
-    def __init__(self, u, scene, laws, *, tractions=(), loads=(), integration=None,
-                 ghost_penalty=0.0, quadrature_degree=None):
+    def __init__(
+        self,
+        u,
+        scene,
+        laws,
+        *,
+        tractions=(),
+        loads=(),
+        integration=None,
+        ghost_penalty=0.0,
+        quadrature_degree=None,
+    ):
         self.u, self.V, self.scene = u, u.function_space, scene
         mesh = scene.mesh
         self.laws = {int(tag): as_law(m) for tag, m in laws.items()}
@@ -47,8 +57,11 @@ class BulkForms:
 
         self.measure = measure
         lin = [law.residual(u, v, measure(t)) for t, law in self.laws.items() if law.linear]
-        nl = [law.residual(u, v, measure(t, nonlinear=True))
-              for t, law in self.laws.items() if not law.linear]
+        nl = [
+            law.residual(u, v, measure(t, nonlinear=True))
+            for t, law in self.laws.items()
+            if not law.linear
+        ]
         a_lin = [ufl.derivative(sum(lin[1:], lin[0]), u, du)] if lin else []
         if integration is not None and ghost_penalty > 0:
             pm = fem.Function(fem.FunctionSpace(mesh, ("DG", 0)), name="p_modulus")
@@ -68,16 +81,19 @@ class BulkForms:
             # explicit zeros on the nonlinear bodies' cells: PETSc drops preallocated entries
             # never set at the first final assembly, and the Jacobian is a copy of K's pattern
             zero = fem.Constant(mesh, 0.0)
-            dxb = ufl.Measure("dx", domain=mesh, subdomain_data=scene.cell_tags,
-                              metadata={"quadrature_degree": 0})
+            dxb = ufl.Measure(
+                "dx", domain=mesh, subdomain_data=scene.cell_tags, metadata={"quadrature_degree": 0}
+            )
             tags = tuple(t for t, law in self.laws.items() if not law.linear)
             self.a_fill = fem.form(zero * ufl.inner(du, v) * dxb(tags))
         # right-hand sides, assembled once: f(lam) = sum scale_k(lam) f_k
         self.rhs = []
         for t in tractions:
             if t.boundary not in scene.boundaries:
-                raise ValueError(f"Traction: unknown boundary {t.boundary!r}; the scene has "
-                                 f"{sorted(scene.boundaries)}")
+                raise ValueError(
+                    f"Traction: unknown boundary {t.boundary!r}; the scene has "
+                    f"{sorted(scene.boundaries)}"
+                )
             tag = scene.boundaries[t.boundary]
             if integration is not None:
                 L = integration.traction_form(self.V, t.traction, tag)
@@ -126,6 +142,5 @@ class BulkForms:
         sig = fem.Function(S, name="stress")
         pts = S.element.interpolation_points()
         for tag, law in self.laws.items():
-            sig.interpolate(fem.Expression(law.cauchy(self.u), pts),
-                            self.scene.cell_tags.find(tag))
+            sig.interpolate(fem.Expression(law.cauchy(self.u), pts), self.scene.cell_tags.find(tag))
         return sig

@@ -31,14 +31,14 @@ class PairGeometry:
     """Contact points of one body pair and what the kernel needs (see module doc)."""
 
     pair: tuple
-    points: np.ndarray      # (nq, 2) on Gamma_c
-    weights: np.ndarray     # (nq,)
-    normals: np.ndarray     # (nq, 2) body i -> j
-    tangents: np.ndarray    # (nq, 2) t = (-n_y, n_x)
-    p_i: np.ndarray         # (nq, 2) closest points on body i
-    p_j: np.ndarray         # (nq, 2)
-    g_n0: np.ndarray        # (nq,)
-    quadrature: object      # _cpp.ContactQuadrature
+    points: np.ndarray  # (nq, 2) on Gamma_c
+    weights: np.ndarray  # (nq,)
+    normals: np.ndarray  # (nq, 2) body i -> j
+    tangents: np.ndarray  # (nq, 2) t = (-n_y, n_x)
+    p_i: np.ndarray  # (nq, 2) closest points on body i
+    p_j: np.ndarray  # (nq, 2)
+    g_n0: np.ndarray  # (nq,)
+    quadrature: object  # _cpp.ContactQuadrature
     grid_spacing: float
     search_box: np.ndarray  # (2, 2)
 
@@ -65,13 +65,17 @@ def body_levelset(grid, body):
     if has_exact_shape(body):
         return _cpp.levelset_from_shape(grid, body.shape)
     if not isinstance(body.shape, _cpp.LevelSet):
-        raise TypeError(f"body {body.name!r}: shape must be a Shape or a LevelSet, "
-                        f"got {type(body.shape).__name__}")
+        raise TypeError(
+            f"body {body.name!r}: shape must be a Shape or a LevelSet, "
+            f"got {type(body.shape).__name__}"
+        )
     try:
         values, _ = body.shape.evaluate(grid.nodes())
     except IndexError as e:
-        raise ValueError(f"body {body.name!r}: its level-set grid does not cover the contact "
-                         f"search box ({e})") from None
+        raise ValueError(
+            f"body {body.name!r}: its level-set grid does not cover the contact "
+            f"search box ({e})"
+        ) from None
     return _cpp.LevelSet(grid, values)
 
 
@@ -86,10 +90,13 @@ def closest_points(body, phi, points, length_scale, exact=True):
 
 
 def _basix_element(cell_type, degree):
-    cell = {"triangle": basix.CellType.triangle,
-            "quadrilateral": basix.CellType.quadrilateral}[cell_type]
+    cell = {"triangle": basix.CellType.triangle, "quadrilateral": basix.CellType.quadrilateral}[
+        cell_type
+    ]
     # Degree <= 2: every Lagrange variant has the same points, so this matches DOLFINx's element
-    return basix.create_element(basix.ElementFamily.P, cell, degree, basix.LagrangeVariant.gll_warped)
+    return basix.create_element(
+        basix.ElementFamily.P, cell, degree, basix.LagrangeVariant.gll_warped
+    )
 
 
 class BodyLocator:
@@ -150,24 +157,33 @@ class GridLocator:
                 k = self.table[ii, jj]
                 ok = k >= 0
                 d = np.full(len(p), np.inf)
-                d[ok] = np.linalg.norm(np.maximum(0, np.maximum(self.lo[k[ok]] - p[ok],
-                                                                p[ok] - self.hi[k[ok]])), axis=1)
+                d[ok] = np.linalg.norm(
+                    np.maximum(0, np.maximum(self.lo[k[ok]] - p[ok], p[ok] - self.hi[k[ok]])),
+                    axis=1,
+                )
                 better = d < dist
                 best[better], dist[better] = k[better], d[better]
         found = (best >= 0) & (dist <= max_distance)
         k = np.where(found, best, 0)
         r = p - self.v0[k]
-        X = np.stack([np.einsum("ij,ij->i", r, self.ex[k]) / np.einsum("ij,ij->i", self.ex[k], self.ex[k]),
-                      np.einsum("ij,ij->i", r, self.ey[k]) / np.einsum("ij,ij->i", self.ey[k], self.ey[k])],
-                     axis=1)
+        X = np.stack(
+            [
+                np.einsum("ij,ij->i", r, self.ex[k])
+                / np.einsum("ij,ij->i", self.ex[k], self.ex[k]),
+                np.einsum("ij,ij->i", r, self.ey[k])
+                / np.einsum("ij,ij->i", self.ey[k], self.ey[k]),
+            ],
+            axis=1,
+        )
         return np.where(found, self.cells[k], -1), X, np.where(found, dist, np.inf)
 
     def basis(self, X):
         return self.element.tabulate(0, X)[0, :, :, 0]
 
 
-def pair_geometry(V, scene, pair, band, *, grid_refine=4, num_gauss=2, max_outside=None,
-                  projection="auto"):
+def pair_geometry(
+    V, scene, pair, band, *, grid_refine=4, num_gauss=2, max_outside=None, projection="auto"
+):
     """Contact quadrature of `pair` (indices into scene.bodies).
 
     band: largest initial gap covered by Gamma_c (eq 22 uses eps = band / 2), a length.
@@ -187,24 +203,30 @@ def pair_geometry(V, scene, pair, band, *, grid_refine=4, num_gauss=2, max_outsi
         return None
     n = np.maximum(np.ceil((box[1] - box[0]) / dx).astype(int), 3)
     hi = box[0] + n * dx  # keep the spacing exactly dx
-    grid = _cpp.StructuredGrid(np.linspace(box[0, 0], hi[0], n[0] + 1),
-                               np.linspace(box[0, 1], hi[1], n[1] + 1))
+    grid = _cpp.StructuredGrid(
+        np.linspace(box[0, 0], hi[0], n[0] + 1), np.linspace(box[0, 1], hi[1], n[1] + 1)
+    )
     phi_i, phi_j = body_levelset(grid, bi), body_levelset(grid, bj)
     s = _cpp.contact_surface(phi_i, phi_j, 0.5 * band, num_gauss)
     # Gamma_c through level-set grid nodes leaves zero-length segments: drop their points
     keep = s["weights"] > 1e-9 * dx
-    s = {k: (v[keep] if isinstance(v, np.ndarray) and len(v) == len(keep) else v)
-         for k, v in s.items()}
+    s = {
+        k: (v[keep] if isinstance(v, np.ndarray) and len(v) == len(keep) else v)
+        for k, v in s.items()
+    }
     if len(s["weights"]) == 0:
         return None
-    proj = [closest_points(b, phi, s["points"], h, exact=projection == "auto")
-            for b, phi in ((bi, phi_i), (bj, phi_j))]
+    proj = [
+        closest_points(b, phi, s["points"], h, exact=projection == "auto")
+        for b, phi in ((bi, phi_i), (bj, phi_j))
+    ]
     for name, pr in zip((bi.name, bj.name), proj):
         if not np.all(pr["converged"]):
             bad = np.flatnonzero(~pr["converged"])[0]
             raise RuntimeError(
                 f"closest-point projection onto body {name!r} failed at contact point "
-                f"{s['points'][bad]} (status {_cpp.ProjectionStatus(int(pr['status'][bad])).name})")
+                f"{s['points'][bad]} (status {_cpp.ProjectionStatus(int(pr['status'][bad])).name})"
+            )
     p_i, p_j = proj[0]["points"], proj[1]["points"]
     normals, tangents = s["normals"], s["tangents"]
     zero = np.zeros_like(p_i)  # reference configuration: g_n = g_n0 (eq 28)
@@ -223,10 +245,14 @@ def pair_geometry(V, scene, pair, band, *, grid_refine=4, num_gauss=2, max_outsi
         cells, X, outside = loc.locate(p, max_outside)
         if np.any(cells < 0):
             bad = np.flatnonzero(cells < 0)[0]
-            raise RuntimeError(f"closest point {p[bad]} on body {body.name!r} is not within "
-                               f"{max_outside:g} of any of its cells on this rank")
+            raise RuntimeError(
+                f"closest point {p[bad]} on body {body.name!r} is not within "
+                f"{max_outside:g} of any of its cells on this rank"
+            )
         sides.append((dofmap[cells].astype(np.int32), loc.basis(X)))
-    q = _cpp.ContactQuadrature(s["weights"], normals, tangents, g_n0,
-                               sides[0][0], sides[1][0], sides[0][1], sides[1][1])
-    return PairGeometry(pair, s["points"], s["weights"], normals, tangents, p_i, p_j, g_n0, q,
-                        dx, box)
+    q = _cpp.ContactQuadrature(
+        s["weights"], normals, tangents, g_n0, sides[0][0], sides[1][0], sides[0][1], sides[1][1]
+    )
+    return PairGeometry(
+        pair, s["points"], s["weights"], normals, tangents, p_i, p_j, g_n0, q, dx, box
+    )

@@ -26,8 +26,9 @@ class ContactSet:
         self.pairs = []
         if V.mesh.comm.rank == rank:
             for pair in scene.pairs:
-                g = pair_geometry(V, scene, pair, band, grid_refine=grid_refine,
-                                  num_gauss=num_gauss)
+                g = pair_geometry(
+                    V, scene, pair, band, grid_refine=grid_refine, num_gauss=num_gauss
+                )
                 if g is not None:
                     self.pairs.append(g)
         self.history = [_cpp.FrictionHistory(len(g.weights), 1) for g in self.pairs]
@@ -49,8 +50,9 @@ class ContactSet:
     def _evaluate(self, k, u, b=None, A=None, fd=False, fd_step=1e-9, mu=None):
         mu = self.mu if mu is None else mu
         gtp = self.history[k].committed if mu > 0 else _NONE
-        return _cpp.assemble_contact(self.pairs[k].quadrature, self.eps_n, self.eps_t, mu, u, gtp,
-                                     b, A, fd, fd_step)
+        return _cpp.assemble_contact(
+            self.pairs[k].quadrature, self.eps_n, self.eps_t, mu, u, gtp, b, A, fd, fd_step
+        )
 
     def assemble(self, u, b, A=None, fd=False, fd_step=1e-9):
         """Add the contact residual of displacement array u to the array b (local, with
@@ -89,8 +91,9 @@ class ContactSet:
         return tuple(s["state"].tobytes() for s in self.last if s is not None)
 
     def state_counts(self):
-        states = (np.concatenate([s["state"] for s in self.last]) if self.last
-                  else np.zeros(0, np.int8))
+        states = (
+            np.concatenate([s["state"] for s in self.last]) if self.last else np.zeros(0, np.int8)
+        )
         return np.bincount(states.astype(int), minlength=3)
 
     def points(self, u):
@@ -100,7 +103,17 @@ class ContactSet:
             s = self.committed[k] if self.committed[k] is not None else self._evaluate(k, u)
             # plastic slip accumulated since friction was switched on (mu = 0: all of g_t)
             slip = self.history[k].committed - self.slip_start[k] if self.mu > 0 else s["g_t"]
-            out.append(dict(x=g.points[:, 0], y=g.points[:, 1], w=g.weights, normals=g.normals,
-                            p_n=-s["tau_n"], p_t=s["tau_t"], gap_n=s["g_n"], slip=slip,
-                            state=s["state"]))
+            out.append(
+                dict(
+                    x=g.points[:, 0],
+                    y=g.points[:, 1],
+                    w=g.weights,
+                    normals=g.normals,
+                    p_n=-s["tau_n"],
+                    p_t=s["tau_t"],
+                    gap_n=s["g_n"],
+                    slip=slip,
+                    state=s["state"],
+                )
+            )
         return out

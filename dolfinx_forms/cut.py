@@ -35,8 +35,11 @@ KERNELS = _cpp.cut_kernels()
 INTERIOR, CUT = 0, 1
 GHOST_FACET = GHOST = 1
 CUT_ID = 1000
-_TYPES = {0: _dcpp.fem.IntegralType.cell, 1: _dcpp.fem.IntegralType.exterior_facet,
-          2: _dcpp.fem.IntegralType.interior_facet}
+_TYPES = {
+    0: _dcpp.fem.IntegralType.cell,
+    1: _dcpp.fem.IntegralType.exterior_facet,
+    2: _dcpp.fem.IntegralType.interior_facet,
+}
 
 
 def _mixed_form(ufl_form, replace, subdomains):
@@ -45,8 +48,9 @@ def _mixed_form(ufl_form, replace, subdomains):
 
     Returns (form, module): keep the module alive as long as the form."""
     mesh = ufl_form.ufl_domain().ufl_cargo()
-    ufcx_form, module, _ = jit.ffcx_jit(mesh.comm, ufl_form,
-                                        form_compiler_params={"scalar_type": "double"})
+    ufcx_form, module, _ = jit.ffcx_jit(
+        mesh.comm, ufl_form, form_compiler_params={"scalar_type": "double"}
+    )
     integrals, perm = {}, False
     for t, itype in _TYPES.items():
         ids = [ufcx_form.integral_ids(t)[k] for k in range(ufcx_form.num_integrals(t))]
@@ -62,8 +66,10 @@ def _mixed_form(ufl_form, replace, subdomains):
             kernels.append((i, ptr))
         integrals[itype] = (kernels, subdomains[t])
     original = ufl_form.coefficients()
-    coeffs = [original[ufcx_form.original_coefficient_position[i]]._cpp_object
-              for i in range(ufcx_form.num_coefficients)]
+    coeffs = [
+        original[ufcx_form.original_coefficient_position[i]]._cpp_object
+        for i in range(ufcx_form.num_coefficients)
+    ]
     consts = [c._cpp_object for c in ufl_form.constants()]
     spaces = [a.ufl_function_space()._cpp_object for a in ufl_form.arguments()]
     if perm:
@@ -89,9 +95,11 @@ def levelset_values(scene, V):
 
 def _check_layout(form, names):
     got = [c.name for c in form.coefficients]
-    if got[:len(names)] != names:
-        raise RuntimeError(f"cut form coefficients packed as {got}, the C++ kernels expect "
-                           f"{names} first (contact/cut_cell.h Layout)")
+    if got[: len(names)] != names:
+        raise RuntimeError(
+            f"cut form coefficients packed as {got}, the C++ kernels expect "
+            f"{names} first (contact/cut_cell.h Layout)"
+        )
 
 
 class BodyMeasure:
@@ -120,8 +128,11 @@ class CutIntegration:
             raise ValueError("cut integration: quadrilateral cells only")
         self.scene, self.mesh, self.degree = scene, scene.mesh, int(degree)
         mesh, cut = scene.mesh, scene.cut
-        self.phi = phi if phi is not None else levelset_values(
-            scene, fem.FunctionSpace(mesh, ("Lagrange", 1)))
+        self.phi = (
+            phi
+            if phi is not None
+            else levelset_values(scene, fem.FunctionSpace(mesh, ("Lagrange", 1)))
+        )
         self.phi.name = "phi"
         # one cell-integral id per (body, kind)
         ncells = len(scene.cell_tags.values)
@@ -130,7 +141,8 @@ class CutIntegration:
         body = np.zeros(ncells, np.int32)
         body[scene.cell_tags.indices] = scene.cell_tags.values
         self.cell_ids = _dcpp.mesh.MeshTags_int32(
-            mesh._mesh, 2, np.arange(ncells, dtype=np.int32), body + CUT_ID * kind)
+            mesh._mesh, 2, np.arange(ncells, dtype=np.int32), body + CUT_ID * kind
+        )
         # moment-fitted weights on cut cells, as factors on FFCx's Gauss weights
         points, wref = basix.make_quadrature(basix.CellType.quadrilateral, self.degree)
         Qe = ufl.FiniteElement("Quadrature", mesh.ufl_cell(), self.degree, quad_scheme="default")
@@ -141,8 +153,9 @@ class CutIntegration:
         f = self.factor.x.array
         f[:] = 1.0
         if len(cells):
-            W = _cpp.cut_moment_weights(np.ascontiguousarray(self.phi.x.array[pdofs[cells]]),
-                                        np.ascontiguousarray(points))
+            W = _cpp.cut_moment_weights(
+                np.ascontiguousarray(self.phi.x.array[pdofs[cells]]), np.ascontiguousarray(points)
+            )
             f[qdofs[cells]] = W / wref
         self.kind = kind
         self.num_cut_cells = len(cells)
@@ -152,11 +165,16 @@ class CutIntegration:
         """The measure over the material of the bodies `tags` (a tag, a list, or None: all)."""
         bodies = sorted(set(self.scene.cell_tags.values)) if tags is None else np.atleast_1d(tags)
         dx = ufl.Measure("dx", domain=self.mesh, subdomain_data=self.cell_ids)
-        dxq = ufl.Measure("dx", domain=self.mesh, subdomain_data=self.cell_ids,
-                          metadata={"quadrature_degree": self.degree})
+        dxq = ufl.Measure(
+            "dx",
+            domain=self.mesh,
+            subdomain_data=self.cell_ids,
+            metadata={"quadrature_degree": self.degree},
+        )
         ids = [int(t) for t in bodies]
-        return BodyMeasure([(dx(tuple(ids)), None),
-                            (dxq(tuple(t + CUT_ID for t in ids)), self.factor)])
+        return BodyMeasure(
+            [(dx(tuple(ids)), None), (dxq(tuple(t + CUT_ID for t in ids)), self.factor)]
+        )
 
     def ghost_penalty(self, u, v, gamma, p_modulus):
         """gamma p_modulus h_n [grad u . n][grad v . n] on the ghost facets (a UFL form);
@@ -173,8 +191,13 @@ class CutIntegration:
         n = ufl.FacetNormal(mesh)
         dS = ufl.Measure("dS", domain=mesh, subdomain_data=self.scene.cut.ghost_facets)
         h_n = ufl.avg(abs(n[0]) * hxy[0] + abs(n[1]) * hxy[1])  # cell width across the face
-        return (gamma * ufl.avg(p_modulus) * h_n
-                * ufl.inner(ufl.jump(ufl.grad(u), n), ufl.jump(ufl.grad(v), n)) * dS(GHOST))
+        return (
+            gamma
+            * ufl.avg(p_modulus)
+            * h_n
+            * ufl.inner(ufl.jump(ufl.grad(u), n), ufl.jump(ufl.grad(v), n))
+            * dS(GHOST)
+        )
 
     def insert_ghost_couplings(self, pattern, V):
         """Add the cell-pair couplings of the ghost-penalty facets to a SparsityPattern."""
@@ -197,15 +220,18 @@ class CutIntegration:
         top.create_connectivity(1, 2)
         f2c = top.connectivity(1, 2)
         cells = f2c.array[f2c.offsets[facets]]
-        tags = _dcpp.mesh.MeshTags_int32(mesh._mesh, 1, facets.astype(np.int32),
-                                         self.kind[cells].astype(np.int32))
+        tags = _dcpp.mesh.MeshTags_int32(
+            mesh._mesh, 1, facets.astype(np.int32), self.kind[cells].astype(np.int32)
+        )
         V2 = fem.VectorFunctionSpace(mesh, ("Lagrange", 2))
         t_h = fem.Function(V2, name="traction")
         t_h.interpolate(fem.Expression(traction, V2.element.interpolation_points()))
         v = ufl.TestFunction(V)
         ds = ufl.Measure("ds", domain=mesh, subdomain_data=tags)
         L = ufl.inner(traction, v) * ds(INTERIOR) + self.phi * ufl.inner(t_h, v) * ds(CUT)
-        form, module = _mixed_form(L, {(1, CUT): KERNELS["traction_q1"]}, {0: None, 1: tags, 2: None})
+        form, module = _mixed_form(
+            L, {(1, CUT): KERNELS["traction_q1"]}, {0: None, 1: tags, 2: None}
+        )
         _check_layout(form, ["phi", "traction"])
         self._keep += [module, t_h, tags]
         return form

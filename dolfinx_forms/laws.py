@@ -48,8 +48,10 @@ class Law:
 
     def describe(self) -> dict:
         """Parameters for metrics.json."""
-        return {"law": type(self).__name__, **{k: v for k, v in vars(self).items()
-                                               if isinstance(v, (int, float, str))}}
+        return {
+            "law": type(self).__name__,
+            **{k: v for k, v in vars(self).items() if isinstance(v, (int, float, str))},
+        }
 
 
 class IsotropicLaw(Law):
@@ -57,8 +59,9 @@ class IsotropicLaw(Law):
 
     def __init__(self, E, nu):
         if not (E > 0 and -1 < nu < 0.5):
-            raise ValueError(f"{type(self).__name__}: need E > 0 and -1 < nu < 0.5, got "
-                             f"E={E}, nu={nu}")
+            raise ValueError(
+                f"{type(self).__name__}: need E > 0 and -1 < nu < 0.5, got " f"E={E}, nu={nu}"
+            )
         self.E, self.nu = float(E), float(nu)
         self.mu, self.lmbda = lame(self.E, self.nu)
         self.modulus, self.p_modulus = self.E, 2 * self.mu + self.lmbda
@@ -83,12 +86,18 @@ class OrthotropicElastic(Law):
     """
 
     def __init__(self, E1, E2, E3, nu12, nu13, nu23, G12, angle=0.0):
-        S = np.array([[1 / E1, -nu12 / E1, -nu13 / E1],
-                      [-nu12 / E1, 1 / E2, -nu23 / E2],
-                      [-nu13 / E1, -nu23 / E2, 1 / E3]])
+        S = np.array(
+            [
+                [1 / E1, -nu12 / E1, -nu13 / E1],
+                [-nu12 / E1, 1 / E2, -nu23 / E2],
+                [-nu13 / E1, -nu23 / E2, 1 / E3],
+            ]
+        )
         if min(E1, E2, E3, G12) <= 0 or np.any(np.linalg.eigvalsh(S) <= 0):
-            raise ValueError("OrthotropicElastic: the constants do not give a positive definite "
-                             "stiffness (need E_i > 0, G12 > 0 and a positive compliance)")
+            raise ValueError(
+                "OrthotropicElastic: the constants do not give a positive definite "
+                "stiffness (need E_i > 0, G12 > 0 and a positive compliance)"
+            )
         C = np.linalg.inv(S)
         self.E1, self.E2, self.E3 = float(E1), float(E2), float(E3)
         self.nu12, self.nu13, self.nu23 = float(nu12), float(nu13), float(nu23)
@@ -100,8 +109,12 @@ class OrthotropicElastic(Law):
         c, s = np.cos(self.angle), np.sin(self.angle)
         R = ufl.as_matrix([[c, -s], [s, c]])  # columns: material axes in x, y
         e = R.T * strain(u) * R
-        sm = ufl.as_matrix([[self.C11 * e[0, 0] + self.C12 * e[1, 1], 2 * self.G12 * e[0, 1]],
-                            [2 * self.G12 * e[0, 1], self.C12 * e[0, 0] + self.C22 * e[1, 1]]])
+        sm = ufl.as_matrix(
+            [
+                [self.C11 * e[0, 0] + self.C12 * e[1, 1], 2 * self.G12 * e[0, 1]],
+                [2 * self.G12 * e[0, 1], self.C12 * e[0, 0] + self.C22 * e[1, 1]],
+            ]
+        )
         return R * sm * R.T
 
 

@@ -48,10 +48,15 @@ def newton(problem, lam):
         r = problem.residual(lam, with_tangent=True)
         residuals.append(r)
         if not np.isfinite(r):
-            return False, residuals, (
-                f"non-finite residual at iteration {it} (a singular system? every body needs "
-                "its rigid motions held by Dirichlet conditions or by contact; a frictionless "
-                "body can slide along the contact)")
+            return (
+                False,
+                residuals,
+                (
+                    f"non-finite residual at iteration {it} (a singular system? every body needs "
+                    "its rigid motions held by Dirichlet conditions or by contact; a frictionless "
+                    "body can slide along the contact)"
+                ),
+            )
         if r0 is None:
             r0 = max(r, opts.atol)
         if r <= max(opts.rtol * r0, opts.atol):
@@ -63,8 +68,9 @@ def newton(problem, lam):
         # An active set seen before without a lower residual: Newton is cycling. The
         # states live on the contact rank only: the decision must be collective.
         sig = problem.contact.signature()
-        cycling = problem.comm.allreduce(bool(sig) and sig in seen and r >= 0.999 * seen[sig],
-                                         op=MPI.LOR)
+        cycling = problem.comm.allreduce(
+            bool(sig) and sig in seen and r >= 0.999 * seen[sig], op=MPI.LOR
+        )
         if cycling:
             return False, residuals, f"active set cycles (iteration {it})"
         seen[sig] = min(r, seen.get(sig, np.inf))
@@ -79,7 +85,11 @@ def newton(problem, lam):
                 return False, residuals, f"linear solver error {e.ierr} at iteration {it}"
             reason = problem.ksp.getConvergedReason()
             if reason < 0:
-                return False, residuals, f"linear solver diverged (reason {reason}) at iteration {it}"
+                return (
+                    False,
+                    residuals,
+                    f"linear solver diverged (reason {reason}) at iteration {it}",
+                )
         problem.du.x.scatter_forward()
         problem.u.x.array[:] += problem.du.x.array
     return False, residuals, f"no convergence in {opts.max_iterations} iterations"
@@ -101,10 +111,12 @@ def load_steps(problem, num_steps=1, lam_end=1.0, label="step", initial_guess=No
             problem.commit(target)
             problem.steps.append(StepLog(target, len(residuals) - 1, residuals, cuts > 0))
             nst = problem.comm.allreduce(problem.contact.state_counts(), MPI.SUM)
-            problem.log(f"{label} lam={target:.4f}: {len(residuals) - 1} Newton iterations, "
-                        f"|R| {residuals[0]:.2e} -> {residuals[-1]:.2e}, "
-                        f"open/stick/slip {nst[0]}/{nst[1]}/{nst[2]} "
-                        f"({time.perf_counter() - t0:.2f} s)")
+            problem.log(
+                f"{label} lam={target:.4f}: {len(residuals) - 1} Newton iterations, "
+                f"|R| {residuals[0]:.2e} -> {residuals[-1]:.2e}, "
+                f"open/stick/slip {nst[0]}/{nst[1]}/{nst[2]} "
+                f"({time.perf_counter() - t0:.2f} s)"
+            )
             continue
         problem.restore()
         cuts += 1
@@ -112,6 +124,7 @@ def load_steps(problem, num_steps=1, lam_end=1.0, label="step", initial_guess=No
             raise ContactSolverError(
                 f"{label}: Newton failed at load level {target:.6g} ({why}); residuals "
                 + ", ".join(f"{r:.3e}" for r in residuals[-5:])
-                + f"; gave up after {problem.newton.max_cutbacks} step cut-backs")
+                + f"; gave up after {problem.newton.max_cutbacks} step cut-backs"
+            )
         dlam /= 2
         problem.log(f"{label} lam={target:.4f}: {why}; cutting the step to {dlam:.4g}")

@@ -30,15 +30,29 @@ def write_tractions(folder, pts):
         w = csv.writer(f)
         w.writerow(TRACTION_COLUMNS)
         for k in range(len(pts["x"])):
-            w.writerow([f"{pts['x'][k]:.12e}", f"{pts['y'][k]:.12e}", f"{pts['p_n'][k]:.12e}",
-                        f"{pts['p_t'][k]:.12e}", f"{pts['gap_n'][k]:.12e}",
-                        f"{pts['slip'][k]:.12e}", STATE_NAMES[int(pts["state"][k])]])
+            w.writerow(
+                [
+                    f"{pts['x'][k]:.12e}",
+                    f"{pts['y'][k]:.12e}",
+                    f"{pts['p_n'][k]:.12e}",
+                    f"{pts['p_t'][k]:.12e}",
+                    f"{pts['gap_n'][k]:.12e}",
+                    f"{pts['slip'][k]:.12e}",
+                    STATE_NAMES[int(pts["state"][k])],
+                ]
+            )
 
 
 def write_columns(path, **columns):
     """A CSV file of equally long columns {name: values}: a header line, then %.12e values."""
-    np.savetxt(path, np.column_stack(list(columns.values())), delimiter=",", fmt="%.12e",
-               header=",".join(columns), comments="")
+    np.savetxt(
+        path,
+        np.column_stack(list(columns.values())),
+        delimiter=",",
+        fmt="%.12e",
+        header=",".join(columns),
+        comments="",
+    )
 
 
 def write_fields(folder, problem, name="solution"):

@@ -22,12 +22,22 @@ def new_metrics(benchmark, discretization, parameters):
         "discretization": discretization,
         "parameters": dict(parameters),
         "mesh": {"h_contact": None, "num_cells": None, "num_dofs": None},
-        "solver": {"load_steps": 0, "newton_iterations": [], "converged": None,
-                   "residual_history": [], "penalty": {"eps_n": None, "eps_t": None}},
+        "solver": {
+            "load_steps": 0,
+            "newton_iterations": [],
+            "converged": None,
+            "residual_history": [],
+            "penalty": {"eps_n": None, "eps_t": None},
+        },
         "timing_s": {k: 0.0 for k in PHASES},
-        "results": {"reaction": None, "contact_half_width": None, "peak_pressure": None,
-                    "stick_half_width": None, "pressure_rel_l2_error": None,
-                    "traction_rel_l2_error": None},
+        "results": {
+            "reaction": None,
+            "contact_half_width": None,
+            "peak_pressure": None,
+            "stick_half_width": None,
+            "pressure_rel_l2_error": None,
+            "traction_rel_l2_error": None,
+        },
         "analytic": {"contact_half_width": None, "peak_pressure": None, "stick_half_width": None},
     }
 

@@ -105,7 +105,16 @@ def _check_scene(scene, spec):
         if d["point"] is not None:
             hit = bool(np.any(_point_marker(d["point"])(X.T[: len(d["point"])])))
             if not comm.allreduce(hit):
-                raise SpecError(f"dirichlet[{i}].point", f"{d['point']} is not a mesh vertex")
+                dist = np.linalg.norm(X[:, : len(d["point"])] - d["point"], axis=1)
+                k = int(np.argmin(dist)) if len(dist) else -1
+                near = comm.allgather(
+                    (dist[k], X[k, : len(d["point"])].tolist()) if k >= 0 else (np.inf, None)
+                )
+                _, q = min(near, key=lambda t: t[0])
+                raise SpecError(
+                    f"dirichlet[{i}].point",
+                    f"{d['point']} is not a mesh vertex (the nearest is " f"[{q[0]!r}, {q[1]!r}])",
+                )
 
 
 def build_problem(spec, scene, timer=None, log=print):

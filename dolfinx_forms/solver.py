@@ -45,10 +45,29 @@ class ContactProblem:
     degree `cut_degree`) with ghost penalty `ghost_penalty` (0: none).
     """
 
-    def __init__(self, scene, materials, *, mu=0.0, eps0=1.0, band=None, degree=1,
-                 dirichlet=(), tractions=(), loads=(), newton=None, petsc_options=None,
-                 grid_refine=4, num_gauss=2, timer=None, contact_rank=0, ghost_penalty=0.01,
-                 quadrature_degree=None, cut_degree=4, log=print):
+    def __init__(
+        self,
+        scene,
+        materials,
+        *,
+        mu=0.0,
+        eps0=1.0,
+        band=None,
+        degree=1,
+        dirichlet=(),
+        tractions=(),
+        loads=(),
+        newton=None,
+        petsc_options=None,
+        grid_refine=4,
+        num_gauss=2,
+        timer=None,
+        contact_rank=0,
+        ghost_penalty=0.01,
+        quadrature_degree=None,
+        cut_degree=4,
+        log=print,
+    ):
         self.scene, self.mesh = scene, scene.mesh
         self.comm = self.mesh.comm
         self.newton = newton or NewtonOptions()
@@ -61,8 +80,9 @@ class ContactProblem:
             self.integration = None
             if getattr(scene, "cut", None) is not None:
                 if degree != 1 or scene.cell_type != "quadrilateral":
-                    raise ValueError("degree: the cut path supports Q1 (degree 1) on "
-                                     "quadrilaterals only")
+                    raise ValueError(
+                        "degree: the cut path supports Q1 (degree 1) on " "quadrilaterals only"
+                    )
                 from .cut import CutIntegration
 
                 self.integration = CutIntegration(scene, degree=cut_degree)
@@ -70,17 +90,25 @@ class ContactProblem:
             self.u = fem.Function(self.V, name="u")
             self.du = fem.Function(self.V)
             self._rc = fem.Function(self.V)  # contact residual, scattered in reverse
-            self.bulk = BulkForms(self.u, scene, self.laws, tractions=tractions, loads=loads,
-                                  integration=self.integration, ghost_penalty=ghost_penalty,
-                                  quadrature_degree=quadrature_degree)
+            self.bulk = BulkForms(
+                self.u,
+                scene,
+                self.laws,
+                tractions=tractions,
+                loads=loads,
+                integration=self.integration,
+                ghost_penalty=ghost_penalty,
+                quadrature_degree=quadrature_degree,
+            )
             self.dirichlet = list(dirichlet)
             self.bc_dofs = [dirichlet_dofs(self.V, scene, d) for d in self.dirichlet]
             imap = self.V.dofmap.index_map
             self.bs = self.V.dofmap.index_map_bs
             self.n_owned = imap.size_local * self.bs
             self.num_dofs = imap.size_global * self.bs
-            all_bc = (np.unique(np.concatenate(self.bc_dofs)) if self.bc_dofs
-                      else np.zeros(0, np.int32))
+            all_bc = (
+                np.unique(np.concatenate(self.bc_dofs)) if self.bc_dofs else np.zeros(0, np.int32)
+            )
             self.bc_owned = all_bc[all_bc < self.n_owned].astype(np.int32)
             self.bc_global = (self.bc_owned + imap.local_range[0] * self.bs).astype(np.int32)
 
@@ -88,17 +116,27 @@ class ContactProblem:
         E_mean = np.mean([law.modulus for law in self.laws.values()])
         self.eps_n = self.eps_t = eps0 * h / E_mean  # eq 51
         with self.phase("contact"):
-            self.contact = ContactSet(self.V, scene, self.eps_n, self.eps_t, mu,
-                                      band if band is not None else 2 * h, grid_refine,
-                                      num_gauss, contact_rank)
+            self.contact = ContactSet(
+                self.V,
+                scene,
+                self.eps_n,
+                self.eps_t,
+                mu,
+                band if band is not None else 2 * h,
+                grid_refine,
+                num_gauss,
+                contact_rank,
+            )
         self.pairs = self.contact.pairs
 
         with self.phase("assembly"):
             # Sparsity: mesh couplings + contact coupling blocks (+ ghost-penalty cell pairs);
             # the pattern never changes.
             pattern = _dcpp.fem.create_sparsity_pattern(
-                self.mesh.topology, [self.V.dofmap._cpp_object, self.V.dofmap._cpp_object],
-                {_dcpp.fem.IntegralType.cell})
+                self.mesh.topology,
+                [self.V.dofmap._cpp_object, self.V.dofmap._cpp_object],
+                {_dcpp.fem.IntegralType.cell},
+            )
             self.contact.insert_couplings(pattern)
             if self.integration is not None and ghost_penalty > 0:
                 self.integration.insert_ghost_couplings(pattern, self.V)
@@ -163,9 +201,13 @@ class ContactProblem:
             self.bulk.add_nonlinear(self.R, self.J if with_tangent else None)
         with self.phase("contact"):
             self._rc.x.array[:] = 0.0
-            self.contact.assemble(self.u.x.array, self._rc.x.array,
-                                  self.J if with_tangent else None,
-                                  self.newton.fd_tangent, self.newton.fd_step)
+            self.contact.assemble(
+                self.u.x.array,
+                self._rc.x.array,
+                self.J if with_tangent else None,
+                self.newton.fd_tangent,
+                self.newton.fd_step,
+            )
             self._rc.x.scatter_reverse(la.ScatterMode.add)
         with self.phase("assembly"):
             self.R.array[:] += self._rc.x.array[: self.n_owned]
@@ -215,12 +257,14 @@ class ContactProblem:
 
 def solver_metrics(problem, converged=True):
     """The `solver` block of metrics.json."""
-    return {"load_steps": len(problem.steps),
-            "newton_iterations": [s.iterations for s in problem.steps],
-            "converged": bool(converged),
-            "residual_history": [[float(r) for r in s.residuals] for s in problem.steps],
-            "penalty": {"eps_n": problem.eps_n, "eps_t": problem.eps_t},
-            "cutbacks": int(sum(s.cutback for s in problem.steps))}
+    return {
+        "load_steps": len(problem.steps),
+        "newton_iterations": [s.iterations for s in problem.steps],
+        "converged": bool(converged),
+        "residual_history": [[float(r) for r in s.residuals] for s in problem.steps],
+        "penalty": {"eps_n": problem.eps_n, "eps_t": problem.eps_t},
+        "cutbacks": int(sum(s.cutback for s in problem.steps)),
+    }
 
 
 def zone_ends(x, inside, gap=None):

@@ -41,10 +41,21 @@ from dolfinx_forms.cut import CUT, GHOST_FACET, INTERIOR, levelset_values  # noq
 from .hertz import hertz_contact_box
 from .scene import Body, Scene, on_box_side, partitioner_kwargs, summary, tag_boundaries
 
-__all__ = ["CutBody", "CutData", "graded_lines", "half_plane", "cut_scene", "levelset_values",
-           "hertz_cut_scene", "patch_cut_scene", "two_blocks_cut_scene", "incline_cut_scene",
-           "cut_counts", "INTERIOR", "CUT"]
-
+__all__ = [
+    "CutBody",
+    "CutData",
+    "graded_lines",
+    "half_plane",
+    "cut_scene",
+    "levelset_values",
+    "hertz_cut_scene",
+    "patch_cut_scene",
+    "two_blocks_cut_scene",
+    "incline_cut_scene",
+    "cut_counts",
+    "INTERIOR",
+    "CUT",
+]
 
 
 # --------------------------------------------------------------------------- grid lines
@@ -61,7 +72,7 @@ def _grade(length, s0, growth, h_far):
     i = np.arange(1, int(nmax) + 1)
 
     def seq(r):
-        return np.minimum(s0 * r ** i, h_far)
+        return np.minimum(s0 * r**i, h_far)
 
     n = int(np.searchsorted(np.cumsum(seq(growth)), length * (1 - 1e-12))) + 1
     i = i[:n]
@@ -106,12 +117,16 @@ def graded_lines(a, b, fine, h, growth=1.2, h_far=None, required=()) -> np.ndarr
     if not growth >= 1:
         raise ValueError(f"graded_lines: growth must be >= 1, got growth={growth}")
     if not a <= c0 <= c1 <= b or a == b:
-        raise ValueError(f"graded_lines: need a <= fine[0] <= fine[1] <= b and a < b, got a={a}, "
-                         f"fine=({c0}, {c1}), b={b}")
+        raise ValueError(
+            f"graded_lines: need a <= fine[0] <= fine[1] <= b and a < b, got a={a}, "
+            f"fine=({c0}, {c1}), b={b}"
+        )
     k = (c1 - c0) / h
     if abs(k - round(k)) > 1e-9:
-        raise ValueError(f"graded_lines: fine=({c0}, {c1}) is not a whole number of cells of "
-                         f"h={h} ((c1 - c0) / h = {k!r})")
+        raise ValueError(
+            f"graded_lines: fine=({c0}, {c1}) is not a whole number of cells of "
+            f"h={h} ((c1 - c0) / h = {k!r})"
+        )
     tol = 1e-9 * h
     fine_lines = c0 + h * np.arange(round(k) + 1)
     fine_lines[-1] = c1
@@ -122,8 +137,10 @@ def graded_lines(a, b, fine, h, growth=1.2, h_far=None, required=()) -> np.ndarr
     idx = np.rint((req[in_fine] - c0) / h).astype(int)
     off = np.abs(req[in_fine] - fine_lines[idx]) > tol
     if off.any():
-        raise ValueError(f"graded_lines: required={list(required)}: {req[in_fine][off]} lie in "
-                         f"fine=({c0}, {c1}) but not on its lines {c0} + k*{h}")
+        raise ValueError(
+            f"graded_lines: required={list(required)}: {req[in_fine][off]} lie in "
+            f"fine=({c0}, {c1}) but not on its lines {c0} + k*{h}"
+        )
     fine_lines[idx] = req[in_fine]  # exactly the required values (e.g. 0, not 2e-17)
     right = _graded_side(np.concatenate([[c1], req[req > c1 + tol]]), h, growth, h_far)
     left = _graded_side(-np.concatenate([[c0], req[req < c0 - tol][::-1]]), h, growth, h_far)
@@ -180,11 +197,13 @@ def _body_grid(xlines, ylines, body):
     the active cells of one body, vertices numbered from 0 (only those of active cells)."""
     w = np.asarray(body.window, float)
     if w.shape != (2, 2) or not np.all(w[1] > w[0]):
-        raise ValueError(f"body {body.name!r}: window must be [[x0, y0], [x1, y1]] with x0 < x1 "
-                         f"and y0 < y1, got {w.tolist()}")
+        raise ValueError(
+            f"body {body.name!r}: window must be [[x0, y0], [x1, y1]] with x0 < x1 "
+            f"and y0 < y1, got {w.tolist()}"
+        )
     i0, i1 = _line_index(xlines, w[:, 0], f"body {body.name!r}: window x bounds")
     j0, j1 = _line_index(ylines, w[:, 1], f"body {body.name!r}: window y bounds")
-    X, Y = xlines[i0:i1 + 1], ylines[j0:j1 + 1]
+    X, Y = xlines[i0 : i1 + 1], ylines[j0 : j1 + 1]
     nx, ny = len(X) - 1, len(Y) - 1
     pts = np.stack(np.meshgrid(X, Y), axis=-1).reshape(-1, 2)  # vertex (i, j) is j (nx+1) + i
     phi = np.asarray(body.shape(pts), float)
@@ -193,8 +212,10 @@ def _body_grid(xlines, ylines, body):
     pc = phi[quads]
     active = pc.min(axis=1) < 0
     if not active.any():
-        raise ValueError(f"body {body.name!r}: no active cell (cut shape >= 0 at every vertex of "
-                         f"window {w.tolist()})")
+        raise ValueError(
+            f"body {body.name!r}: no active cell (cut shape >= 0 at every vertex of "
+            f"window {w.tolist()})"
+        )
     kinds = np.where(pc[active].max(axis=1) > 0, CUT, INTERIOR).astype(np.int32)
     used, cells = np.unique(quads[active], return_inverse=True)
     bbox = body.bbox
@@ -225,8 +246,17 @@ def _ghost_facets(mesh, kinds):
     return tags
 
 
-def cut_scene(comm, xlines, ylines, bodies, boundary_markers, pairs, h_contact, contact_box=None,
-              ghost_mode=dolfinx.mesh.GhostMode.shared_facet) -> Scene:
+def cut_scene(
+    comm,
+    xlines,
+    ylines,
+    bodies,
+    boundary_markers,
+    pairs,
+    h_contact,
+    contact_box=None,
+    ghost_mode=dolfinx.mesh.GhostMode.shared_facet,
+) -> Scene:
     """Collective: the cut-cell Scene (cell_type "quadrilateral", Scene.cut set) of `bodies`
     (CutBody or (name, tag, window, cut_shape[, bbox]) tuples) on the grid xlines x ylines.
 
@@ -271,8 +301,9 @@ def cut_scene(comm, xlines, ylines, bodies, boundary_markers, pairs, h_contact, 
     domain = ufl.Mesh(ufl.VectorElement("Lagrange", ufl.quadrilateral, 1))
     # default contact box: from the pairs and the bodies' bboxes (known on every rank)
     box_bodies = [Body(b.name, b.tag, None, bbox) for b, bbox in zip(bodies, bboxes)]
-    kwargs = partitioner_kwargs(comm, x, cells, "quadrilateral", contact_box, box_bodies, pairs,
-                                h_contact)
+    kwargs = partitioner_kwargs(
+        comm, x, cells, "quadrilateral", contact_box, box_bodies, pairs, h_contact
+    )
     mesh = dolfinx.mesh.create_mesh(comm, cells, x, domain, ghost_mode=ghost_mode, **kwargs)
 
     tdim = mesh.topology.dim
@@ -284,15 +315,30 @@ def cut_scene(comm, xlines, ylines, bodies, boundary_markers, pairs, h_contact, 
     kind_tags = dolfinx.mesh.meshtags(mesh, tdim, local, ckinds)
     kind_tags.name = "kinds"
     windows = {b.tag: np.asarray(b.window, float) for b in bodies}
-    scene_bodies = [Body(b.name, b.tag, df.Intersection([b.shape, df.Box(*windows[b.tag])]), bbox)
-                    for b, bbox in zip(bodies, bboxes)]
+    scene_bodies = [
+        Body(b.name, b.tag, df.Intersection([b.shape, df.Box(*windows[b.tag])]), bbox)
+        for b, bbox in zip(bodies, bboxes)
+    ]
     facet_tags, boundaries = tag_boundaries(mesh, cvalues, scene_bodies, boundary_markers)
-    cut = CutData(xlines=xlines, ylines=ylines, windows=windows,
-                  levelsets={b.tag: b.shape for b in bodies}, kind_tags=kind_tags,
-                  ghost_facets=_ghost_facets(mesh, ckinds))
-    return Scene(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, boundaries=boundaries,
-                 bodies=scene_bodies, pairs=[tuple(p) for p in pairs], h_contact=float(h_contact),
-                 cell_type="quadrilateral", cut=cut)
+    cut = CutData(
+        xlines=xlines,
+        ylines=ylines,
+        windows=windows,
+        levelsets={b.tag: b.shape for b in bodies},
+        kind_tags=kind_tags,
+        ghost_facets=_ghost_facets(mesh, ckinds),
+    )
+    return Scene(
+        mesh=mesh,
+        cell_tags=cell_tags,
+        facet_tags=facet_tags,
+        boundaries=boundaries,
+        bodies=scene_bodies,
+        pairs=[tuple(p) for p in pairs],
+        h_contact=float(h_contact),
+        cell_type="quadrilateral",
+        cut=cut,
+    )
 
 
 # --------------------------------------------------------------------------- generators
@@ -305,15 +351,28 @@ def _window_markers(windows, specs, tol):
     """boundary_markers for cut_scene: specs [(name, body, window sides or None)] give name ->
     (tag 1, 2, ... in order, predicate, body); the predicate matches the given sides of the
     body's window (see on_box_side), None (a cut boundary, not grid aligned) matches nothing."""
+
     def pred(body, sides):
         return _nothing if sides is None else on_box_side(*windows[body], sides, tol)
 
-    return {name: (tag, pred(body, sides), body)
-            for tag, (name, body, sides) in enumerate(specs, start=1)}
+    return {
+        name: (tag, pred(body, sides), body)
+        for tag, (name, body, sides) in enumerate(specs, start=1)
+    }
 
 
-def hertz_cut_scene(comm, R=10.0, width=40.0, depth=20.0, h=0.05, zone=1.5, h_far=None,
-                    growth=1.2, contact_box=None, Ry=None) -> Scene:
+def hertz_cut_scene(
+    comm,
+    R=10.0,
+    width=40.0,
+    depth=20.0,
+    h=0.05,
+    zone=1.5,
+    h_far=None,
+    growth=1.2,
+    contact_box=None,
+    Ry=None,
+) -> Scene:
     """The Hertz scene of meshes/hertz.py on a graded grid (spacing h on [-z, z]^2, z = zone
     rounded up to a multiple of h); the block has no cut cell, the indenter (window
     [-R, R] x [0, Ry]) is cut by its circle, or by its ellipse of semi-axes R (horizontal) and Ry
@@ -327,8 +386,10 @@ def hertz_cut_scene(comm, R=10.0, width=40.0, depth=20.0, h=0.05, zone=1.5, h_fa
     k = zone / h
     z = zone if abs(k - round(k)) < 1e-9 else h * np.ceil(k)
     if not z < min(R, Ry, W, depth):
-        raise ValueError(f"hertz_cut_scene: zone {z} (rounded up to a multiple of h) must be "
-                         f"< min(R, Ry, width/2, depth) = {min(R, Ry, W, depth)}")
+        raise ValueError(
+            f"hertz_cut_scene: zone {z} (rounded up to a multiple of h) must be "
+            f"< min(R, Ry, width/2, depth) = {min(R, Ry, W, depth)}"
+        )
     h_far = max(h, min(R, Ry, depth) / 8 if h_far is None else h_far)
     xmax = max(W, R)
     xlines = graded_lines(-xmax, xmax, (-z, z), h, growth, h_far, required=[-W, -R, 0.0, R, W])
@@ -337,13 +398,22 @@ def hertz_cut_scene(comm, R=10.0, width=40.0, depth=20.0, h=0.05, zone=1.5, h_fa
     block = np.array([[-W, -depth], [W, 0.0]])
     bodies = [
         CutBody("block", 1, block, df.Box(block[0] - m, block[1] + m), block),
-        CutBody("cylinder", 2, np.array([[-R, 0.0], [R, Ry]]), indenter_shape(R, Ry),
-                np.array([[-R, 0.0], [R, Ry]])),
+        CutBody(
+            "cylinder",
+            2,
+            np.array([[-R, 0.0], [R, Ry]]),
+            indenter_shape(R, Ry),
+            np.array([[-R, 0.0], [R, Ry]]),
+        ),
     ]
-    specs = [("block_bottom", 0, ["bottom"]), ("block_sides", 0, ["left", "right"]),
-             ("block_top", 0, ["top"]), ("cylinder_top", 1, ["top"]), ("cylinder_arc", 1, None)]
-    markers = _window_markers([b.window for b in bodies], specs,
-                              1e-8 * max(R, Ry, width, depth))
+    specs = [
+        ("block_bottom", 0, ["bottom"]),
+        ("block_sides", 0, ["left", "right"]),
+        ("block_top", 0, ["top"]),
+        ("cylinder_top", 1, ["top"]),
+        ("cylinder_arc", 1, None),
+    ]
+    markers = _window_markers([b.window for b in bodies], specs, 1e-8 * max(R, Ry, width, depth))
     box = hertz_contact_box(R, width, depth, zone, Ry) if contact_box is None else contact_box
     return cut_scene(comm, xlines, ylines, bodies, markers, [(0, 1)], h, contact_box=box)
 
@@ -358,24 +428,39 @@ def patch_cut_scene(comm, n=5, width=1.0, height=1.0, interface=0.5, nx=None) ->
     hy = height / n
     k = interface / hy
     if not 0 < interface < height or abs(k - round(k)) < 1e-9:
-        raise ValueError(f"patch_cut_scene: interface={interface} must lie strictly inside "
-                         f"(0, {height}) and not on a grid line (spacing {hy})")
+        raise ValueError(
+            f"patch_cut_scene: interface={interface} must lie strictly inside "
+            f"(0, {height}) and not on a grid line (spacing {hy})"
+        )
     above, below = ylines[int(np.ceil(k))], ylines[int(np.floor(k))]
     windows = [np.array([[0.0, 0.0], [width, above]]), np.array([[0.0, below], [width, height]])]
     ext = 100 * max(width, height)
     bodies = [
-        CutBody("lower", 1, windows[0], half_plane((0.0, interface), (0.0, 1.0), ext),
-                np.array([[0.0, 0.0], [width, interface]])),
-        CutBody("upper", 2, windows[1], half_plane((0.0, interface), (0.0, -1.0), ext),
-                np.array([[0.0, interface], [width, height]])),
+        CutBody(
+            "lower",
+            1,
+            windows[0],
+            half_plane((0.0, interface), (0.0, 1.0), ext),
+            np.array([[0.0, 0.0], [width, interface]]),
+        ),
+        CutBody(
+            "upper",
+            2,
+            windows[1],
+            half_plane((0.0, interface), (0.0, -1.0), ext),
+            np.array([[0.0, interface], [width, height]]),
+        ),
     ]
-    specs = [(f"{name}_{side}", body, None if side == cut else [side])
-             for body, (name, cut) in enumerate([("lower", "top"), ("upper", "bottom")])
-             for side in ("bottom", "left", "right", "top")]
+    specs = [
+        (f"{name}_{side}", body, None if side == cut else [side])
+        for body, (name, cut) in enumerate([("lower", "top"), ("upper", "bottom")])
+        for side in ("bottom", "left", "right", "top")
+    ]
     markers = _window_markers(windows, specs, 1e-8 * max(width, height))
     box = np.array([[0.0, interface - hy], [width, interface + hy]])
-    return cut_scene(comm, xlines, ylines, bodies, markers, [(0, 1)], max(width / nx, hy),
-                     contact_box=box)
+    return cut_scene(
+        comm, xlines, ylines, bodies, markers, [(0, 1)], max(width / nx, hy), contact_box=box
+    )
 
 
 def two_blocks_cut_scene(comm, h=0.2, width_lower=40.0, height=10.0, width_upper=20.0) -> Scene:
@@ -393,22 +478,41 @@ def two_blocks_cut_scene(comm, h=0.2, width_lower=40.0, height=10.0, width_upper
     ylines = np.linspace(0.0, 2 * height, ny + 1)
     above, below = ylines[(ny + 1) // 2], ylines[(ny - 1) // 2]
     u0, u1 = req[1:3]
-    windows = [np.array([[0.0, 0.0], [width_lower, above]]),
-               np.array([[u0, below], [u1, 2 * height]])]
+    windows = [
+        np.array([[0.0, 0.0], [width_lower, above]]),
+        np.array([[u0, below], [u1, 2 * height]]),
+    ]
     ext = 100 * max(width_lower, 2 * height)
     bodies = [
-        CutBody("lower", 1, windows[0], half_plane((0.0, height), (0.0, 1.0), ext),
-                np.array([[0.0, 0.0], [width_lower, height]])),
-        CutBody("upper", 2, windows[1], half_plane((0.0, height), (0.0, -1.0), ext),
-                np.array([[u0, height], [u1, 2 * height]])),
+        CutBody(
+            "lower",
+            1,
+            windows[0],
+            half_plane((0.0, height), (0.0, 1.0), ext),
+            np.array([[0.0, 0.0], [width_lower, height]]),
+        ),
+        CutBody(
+            "upper",
+            2,
+            windows[1],
+            half_plane((0.0, height), (0.0, -1.0), ext),
+            np.array([[u0, height], [u1, 2 * height]]),
+        ),
     ]
-    specs = [("lower_bottom", 0, ["bottom"]), ("lower_left", 0, ["left"]),
-             ("lower_right", 0, ["right"]), ("lower_top", 0, None), ("upper_top", 1, ["top"]),
-             ("upper_bottom", 1, None), ("upper_sides", 1, ["left", "right"])]
+    specs = [
+        ("lower_bottom", 0, ["bottom"]),
+        ("lower_left", 0, ["left"]),
+        ("lower_right", 0, ["right"]),
+        ("lower_top", 0, None),
+        ("upper_top", 1, ["top"]),
+        ("upper_bottom", 1, None),
+        ("upper_sides", 1, ["left", "right"]),
+    ]
     markers = _window_markers(windows, specs, 1e-8 * width_lower)
     box = np.array([[u0, height - 2 * h], [u1, height + 2 * h]])
-    return cut_scene(comm, xlines, ylines, bodies, markers, [(0, 1)], max(hx, ylines[1]),
-                     contact_box=box)
+    return cut_scene(
+        comm, xlines, ylines, bodies, markers, [(0, 1)], max(hx, ylines[1]), contact_box=box
+    )
 
 
 def incline_cut_scene(comm, h=25.0, size=1000.0, slope=0.2, intercept=458.6) -> Scene:
@@ -421,14 +525,28 @@ def incline_cut_scene(comm, h=25.0, size=1000.0, slope=0.2, intercept=458.6) -> 
     lines = np.linspace(0.0, size, n + 1)
     square = np.array([[0.0, 0.0], [size, size]])
     up = np.array([-slope, 1.0])
-    polys = [np.array([[0, 0], [size, 0], [size, y1], [0, y0]]),
-             np.array([[0, y0], [size, y1], [size, size], [0, size]])]
-    bodies = [CutBody(name, i + 1, square, half_plane((0.0, intercept), sign * up, 100 * size),
-                      np.array([p.min(axis=0), p.max(axis=0)], float))
-              for i, (name, sign, p) in enumerate(zip(["lower", "upper"], [1, -1], polys))]
-    specs = [("lower_bottom", 0, ["bottom"]), ("upper_top", 1, ["top"]),
-             ("lower_sides", 0, ["left", "right"]), ("upper_sides", 1, ["left", "right"]),
-             ("lower_interface", 0, None), ("upper_interface", 1, None)]
+    polys = [
+        np.array([[0, 0], [size, 0], [size, y1], [0, y0]]),
+        np.array([[0, y0], [size, y1], [size, size], [0, size]]),
+    ]
+    bodies = [
+        CutBody(
+            name,
+            i + 1,
+            square,
+            half_plane((0.0, intercept), sign * up, 100 * size),
+            np.array([p.min(axis=0), p.max(axis=0)], float),
+        )
+        for i, (name, sign, p) in enumerate(zip(["lower", "upper"], [1, -1], polys))
+    ]
+    specs = [
+        ("lower_bottom", 0, ["bottom"]),
+        ("upper_top", 1, ["top"]),
+        ("lower_sides", 0, ["left", "right"]),
+        ("upper_sides", 1, ["left", "right"]),
+        ("lower_interface", 0, None),
+        ("upper_interface", 1, None),
+    ]
     markers = _window_markers([square, square], specs, 1e-8 * size)
     box = np.array([[0.0, min(y0, y1) - 2 * h], [size, max(y0, y1) + 2 * h]])
     return cut_scene(comm, lines, lines, bodies, markers, [(0, 1)], size / n, contact_box=box)
@@ -439,8 +557,10 @@ def cut_counts(scene: Scene) -> dict[str, int]:
     owned = scene.cell_tags.indices < scene.mesh.topology.index_map(2).size_local
     cut = scene.cut.kind_tags.values == CUT
     tags = scene.cell_tags.values
-    return {b.name: scene.mesh.comm.allreduce(int(np.sum(owned & cut & (tags == b.tag))))
-            for b in scene.bodies}
+    return {
+        b.name: scene.mesh.comm.allreduce(int(np.sum(owned & cut & (tags == b.tag))))
+        for b in scene.bodies
+    }
 
 
 if __name__ == "__main__":
@@ -450,16 +570,23 @@ if __name__ == "__main__":
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scene", choices=["hertz", "patch", "two_blocks", "incline"], default="hertz")
-    ap.add_argument("--h", type=float, default=None,
-                    help="grid spacing (hertz, two_blocks, incline; default: theirs)")
+    ap.add_argument(
+        "--h",
+        type=float,
+        default=None,
+        help="grid spacing (hertz, two_blocks, incline; default: theirs)",
+    )
     ap.add_argument("--n", type=int, default=5, help="patch: cells over the height")
     args = ap.parse_args()
     comm = MPI.COMM_WORLD
     if args.scene == "patch":
         s = patch_cut_scene(comm, n=args.n)
     else:
-        make = {"hertz": hertz_cut_scene, "two_blocks": two_blocks_cut_scene,
-                "incline": incline_cut_scene}[args.scene]
+        make = {
+            "hertz": hertz_cut_scene,
+            "two_blocks": two_blocks_cut_scene,
+            "incline": incline_cut_scene,
+        }[args.scene]
         s = make(comm) if args.h is None else make(comm, h=args.h)
     line, counts = summary(s), cut_counts(s)
     if comm.rank == 0:

@@ -95,14 +95,16 @@ def _build(gmsh, R, W, depth, z, h, h_far, quads, Ry=None):
     surface([-zb_r, -down, top_r, -mid], True)
     surface([-zb_l, mid, top_l, -up], True)
     # cylinder: the zone part {|x| <= z, y <= z} above the arc (two halves), and the rest
-    c, a, pl, o2, pr, b, ztl, ztm, ztr = pts((0, Ry), (-R, Ry), (-z, sag), (0, 0), (z, sag),
-                                             (R, Ry), (-z, z), (0, z), (z, z))
+    c, a, pl, o2, pr, b, ztl, ztm, ztr = pts(
+        (0, Ry), (-R, Ry), (-z, sag), (0, 0), (z, sag), (R, Ry), (-z, z), (0, z), (z, z)
+    )
     if Ry == R:
         arcs = [geo.addCircleArc(p, c, q) for p, q in [(a, pl), (pl, o2), (o2, pr), (pr, b)]]
     else:  # the major-axis point: (R, Ry) on the horizontal axis, else the origin (vertical)
         major = b if R > Ry else o2
-        arcs = [geo.addEllipseArc(p, c, major, q)
-                for p, q in [(a, pl), (pl, o2), (o2, pr), (pr, b)]]
+        arcs = [
+            geo.addEllipseArc(p, c, major, q) for p, q in [(a, pl), (pl, o2), (o2, pr), (pr, b)]
+        ]
     side_l, zt_l, zt_r, side_r = lines([pl, ztl, ztm, ztr, pr], closed=False)
     top, cmid = geo.addLine(b, a), geo.addLine(o2, ztm)
     surface([arcs[0], side_l, zt_l, zt_r, side_r, arcs[3], top])
@@ -147,8 +149,18 @@ def indenter_shape(R, Ry):
     return df.Circle((0.0, R), R) if Ry == R else df.Ellipse((0.0, Ry), R, Ry)
 
 
-def hertz_scene(comm, R=10.0, width=40.0, depth=20.0, h=0.05, zone=1.5, h_far=None,
-                quads=False, contact_box=None, Ry=None) -> Scene:
+def hertz_scene(
+    comm,
+    R=10.0,
+    width=40.0,
+    depth=20.0,
+    h=0.05,
+    zone=1.5,
+    h_far=None,
+    quads=False,
+    contact_box=None,
+    Ry=None,
+) -> Scene:
     """The Hertz scene (see the module docstring): a half-ellipse of semi-axes R (horizontal)
     and Ry (vertical, default R: the half-cylinder) on the block; contact_box overrides
     hertz_contact_box()."""
@@ -160,18 +172,23 @@ def hertz_scene(comm, R=10.0, width=40.0, depth=20.0, h=0.05, zone=1.5, h_far=No
     bodies = [
         Body("block", 1, df.Box((-W, -depth), (W, 0.0)), np.array([[-W, -depth], [W, 0.0]])),
         Body(
-            "cylinder", 2,
+            "cylinder",
+            2,
             df.Intersection([indenter_shape(R, Ry), df.Box((-R - 1, -1.0), (R + 1, Ry))]),
             np.array([[-R, 0.0], [R, Ry]]),
         ),
     ]
     tol = 1e-8 * max(R, Ry, width, depth)
     if Ry == R:
+
         def on_arc(x):
             return np.abs(np.hypot(x[0], x[1] - R) - R) < tol
+
     else:  # |algebraic distance| scaled by the smaller semi-axis (<= the true distance)
+
         def on_arc(x):
             return np.abs(np.hypot(x[0] / R, (x[1] - Ry) / Ry) - 1) * min(R, Ry) < tol
+
     markers = {
         "block_bottom": (1, lambda x: np.isclose(x[1], -depth, atol=tol), 0),
         "block_sides": (2, lambda x: np.isclose(np.abs(x[0]), W, atol=tol), 0),

@@ -23,11 +23,16 @@ def incline_scene(comm, h=25.0, quads=False, size=1000.0, slope=0.2, intercept=4
 
     y0, y1 = intercept, slope * size + intercept
     assert 0 < y0 < size and 0 < y1 < size, "the line must cross both vertical sides"
-    polys = [np.array([[0, 0], [size, 0], [size, y1], [0, y0]]),
-             np.array([[0, y0], [size, y1], [size, size], [0, size]])]
-    bodies = [Body(name, i + 1, df.Polygon(p), np.array([p.min(axis=0), p.max(axis=0)]))
-              for i, (name, p) in enumerate(zip(["lower", "upper"], polys))]
+    polys = [
+        np.array([[0, 0], [size, 0], [size, y1], [0, y0]]),
+        np.array([[0, y0], [size, y1], [size, size], [0, size]]),
+    ]
+    bodies = [
+        Body(name, i + 1, df.Polygon(p), np.array([p.min(axis=0), p.max(axis=0)]))
+        for i, (name, p) in enumerate(zip(["lower", "upper"], polys))
+    ]
     tol = 1e-8 * size
+
     def side(x):
         return np.isclose(x[0], 0.0, atol=tol) | np.isclose(x[0], size, atol=tol)
 

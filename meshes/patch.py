@@ -23,8 +23,10 @@ def patch_scene(comm, nx=4, ny=2, quads=True, width=1.0, height=0.5, nx_upper=No
     import dolfinx_forms as df
 
     nx_upper = nx if nx_upper is None else nx_upper
-    boxes = [np.array([[0.0, 0.0], [width, height]]),
-             np.array([[0.0, height], [width, 2 * height]])]
+    boxes = [
+        np.array([[0.0, 0.0], [width, height]]),
+        np.array([[0.0, height], [width, 2 * height]]),
+    ]
     bodies = [Body(n, i + 1, df.Box(*b), b) for i, (n, b) in enumerate(zip(NAMES, boxes))]
     tol = 1e-8 * max(width, height)
     markers, tag = {}, 1
@@ -69,5 +71,9 @@ def patch_dirichlet(d, height=1.0):
     def corner(y):
         return lambda x: np.isclose(x[0], 0.0) & np.isclose(x[1], y)
 
-    return [Dirichlet("lower_bottom", 1, 0.0), Dirichlet("upper_top", 1, lambda lam: -d * lam),
-            Dirichlet(corner(0.0), 0, 0.0), Dirichlet(corner(height), 0, 0.0)]
+    return [
+        Dirichlet("lower_bottom", 1, 0.0),
+        Dirichlet("upper_top", 1, lambda lam: -d * lam),
+        Dirichlet(corner(0.0), 0, 0.0),
+        Dirichlet(corner(height), 0, 0.0),
+    ]

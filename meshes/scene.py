@@ -36,9 +36,24 @@ import numpy as np
 if TYPE_CHECKING:
     from .cut import CutData
 
-__all__ = ["Body", "Scene", "scene_from_gmsh", "gmsh_model", "contact_partitioner", "cell_bboxes",
-           "add_polygon", "on_box_side", "summary", "cell_edges", "max_edge_in_box", "extract_gmsh",
-           "tag_boundaries", "pairs_contact_boxes", "partitioner_kwargs", "CONTACT_BOX_MARGIN"]
+__all__ = [
+    "Body",
+    "Scene",
+    "scene_from_gmsh",
+    "gmsh_model",
+    "contact_partitioner",
+    "cell_bboxes",
+    "add_polygon",
+    "on_box_side",
+    "summary",
+    "cell_edges",
+    "max_edge_in_box",
+    "extract_gmsh",
+    "tag_boundaries",
+    "pairs_contact_boxes",
+    "partitioner_kwargs",
+    "CONTACT_BOX_MARGIN",
+]
 
 # Default contact box: each pair's bbox overlap inflated by this many h_contact. The contact
 # search (dolfinx_forms.contact) covers the overlap inflated by band + h_contact (default band
@@ -179,8 +194,9 @@ def cell_edges(x: np.ndarray, cells: np.ndarray) -> np.ndarray:
     """Edge lengths (num_cells, num_edges) of triangles or quads (DOLFINx vertex order)."""
     edges = _EDGES["triangle" if cells.shape[1] == 3 else "quadrilateral"]
     xc = x[:, :2]
-    return np.stack([np.linalg.norm(xc[cells[:, i]] - xc[cells[:, j]], axis=1) for i, j in edges],
-                    axis=1)
+    return np.stack(
+        [np.linalg.norm(xc[cells[:, i]] - xc[cells[:, j]], axis=1) for i, j in edges], axis=1
+    )
 
 
 def max_edge_in_box(x: np.ndarray, cells: np.ndarray, box) -> float:
@@ -266,8 +282,9 @@ def contact_partitioner(x: np.ndarray, cells: np.ndarray, cell_name: str, contac
             c = centroid[rest]
             d = np.full(len(rest), np.inf)
             for box in boxes:
-                d = np.minimum(d, np.linalg.norm(np.maximum(0.0, np.maximum(box[0] - c,
-                                                                           c - box[1])), axis=1))
+                d = np.minimum(
+                    d, np.linalg.norm(np.maximum(0.0, np.maximum(box[0] - c, c - box[1])), axis=1)
+                )
             near = np.argsort(d, kind="stable")
             others = rest[near[n0:]]
             axis = int(np.argmax(np.ptp(centroid[others], axis=0))) if len(others) else 0
@@ -301,8 +318,10 @@ def extract_gmsh(gmsh):
     types, _, nodes = gmsh.model.mesh.getElements(dim=2)
     types = [int(t) for t in types]
     if len(types) != 1 or types[0] not in _GMSH_CELLS:
-        raise RuntimeError(f"need one first-order cell type (3-node triangles or 4-node quads), "
-                           f"gmsh gave types {types}")
+        raise RuntimeError(
+            f"need one first-order cell type (3-node triangles or 4-node quads), "
+            f"gmsh gave types {types}"
+        )
     gtype = types[0]
     name, nv = _GMSH_CELLS[gtype]
     lut = np.full(int(tags.max()) + 1, -1, np.int64)
@@ -343,8 +362,15 @@ def tag_boundaries(mesh, cell_values, bodies, boundary_markers):
     return facet_tags, boundaries
 
 
-def scene_from_gmsh(comm, bodies, boundary_markers, pairs, h_contact, contact_box=None,
-                    ghost_mode=dolfinx.mesh.GhostMode.shared_facet) -> Scene:
+def scene_from_gmsh(
+    comm,
+    bodies,
+    boundary_markers,
+    pairs,
+    h_contact,
+    contact_box=None,
+    ghost_mode=dolfinx.mesh.GhostMode.shared_facet,
+) -> Scene:
     """Collective: build the Scene from the meshed gmsh model on rank 0 (first-order 2D cells).
 
     boundary_markers: name -> (tag, predicate) or (tag, predicate, body), predicate(x) for x of
@@ -389,9 +415,16 @@ def scene_from_gmsh(comm, bodies, boundary_markers, pairs, h_contact, contact_bo
 
     facet_tags, boundaries = tag_boundaries(mesh, cvalues, bodies, boundary_markers)
 
-    return Scene(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, boundaries=boundaries,
-                 bodies=list(bodies), pairs=[tuple(p) for p in pairs], h_contact=float(h_contact),
-                 cell_type=cell_name)
+    return Scene(
+        mesh=mesh,
+        cell_tags=cell_tags,
+        facet_tags=facet_tags,
+        boundaries=boundaries,
+        bodies=list(bodies),
+        pairs=[tuple(p) for p in pairs],
+        h_contact=float(h_contact),
+        cell_type=cell_name,
+    )
 
 
 def summary(scene: Scene) -> str:

@@ -21,13 +21,16 @@ from .scene import Body, Scene, add_polygon, gmsh_model, on_box_side, scene_from
 NAMES = ("lower", "upper")  # body 0, body 1
 
 
-def two_blocks_scene(comm, h=0.2, quads=True, width_lower=40.0, height=10.0,
-                     width_upper=20.0) -> Scene:
+def two_blocks_scene(
+    comm, h=0.2, quads=True, width_lower=40.0, height=10.0, width_upper=20.0
+) -> Scene:
     import dolfinx_forms as df
 
     c = width_lower / 2
-    boxes = [np.array([[0.0, 0.0], [width_lower, height]]),
-             np.array([[c - width_upper / 2, height], [c + width_upper / 2, 2 * height]])]
+    boxes = [
+        np.array([[0.0, 0.0], [width_lower, height]]),
+        np.array([[c - width_upper / 2, height], [c + width_upper / 2, 2 * height]]),
+    ]
     bodies = [Body(n, i + 1, df.Box(*b), b) for i, (n, b) in enumerate(zip(NAMES, boxes))]
     tol = 1e-8 * width_lower
     (l0, l1), (u0, u1) = boxes

@@ -20,8 +20,9 @@ def make_quadrature(rng, nq=40, ni=3, nj=4):
     n = np.c_[np.cos(theta), np.sin(theta)]
     t = np.c_[-n[:, 1], n[:, 0]]
     dofs_i = np.array([rng.choice(NNODES // 2, ni, replace=False) for _ in range(nq)], np.int32)
-    dofs_j = np.array([NNODES // 2 + rng.choice(NNODES // 2, nj, replace=False)
-                       for _ in range(nq)], np.int32)
+    dofs_j = np.array(
+        [NNODES // 2 + rng.choice(NNODES // 2, nj, replace=False) for _ in range(nq)], np.int32
+    )
     bi = rng.uniform(0.1, 1, (nq, ni))
     bj = rng.uniform(0.1, 1, (nq, nj))
     bi /= bi.sum(1, keepdims=True)
@@ -32,8 +33,9 @@ def make_quadrature(rng, nq=40, ni=3, nj=4):
 
 
 def dense_tangent(q, law, u, gtp, fd=False):
-    A = PETSc.Mat().createAIJ((2 * NNODES, 2 * NNODES), bsize=2, nnz=2 * NNODES,
-                              comm=PETSc.COMM_SELF)
+    A = PETSc.Mat().createAIJ(
+        (2 * NNODES, 2 * NNODES), bsize=2, nnz=2 * NNODES, comm=PETSc.COMM_SELF
+    )
     lg = PETSc.LGMap().create(np.arange(NNODES, dtype=np.int32), bsize=2, comm=PETSc.COMM_SELF)
     A.setLGMap(lg, lg)
     A.setUp()
@@ -91,7 +93,7 @@ def test_residual_is_weighted_traction():
     b = np.zeros_like(u)
     s = _cpp.assemble_contact(q, 1e-2, 2e-2, 0.4, u, gtp, b)
     b = b.reshape(-1, 2)
-    fi, fj = b[: NNODES // 2].sum(0), b[NNODES // 2:].sum(0)
+    fi, fj = b[: NNODES // 2].sum(0), b[NNODES // 2 :].sum(0)
     np.testing.assert_allclose(fi, -fj, atol=1e-12)
     assert np.abs(fj).max() > 0
 

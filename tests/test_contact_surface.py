@@ -19,15 +19,24 @@ def exact_curve_length(fA, fB, y0, y1, xbracket, n=4001):
     """Arc length of {phi_A = phi_B} between heights y0 < y1, the curve being a graph x(y)."""
     ys = np.linspace(y0, y1, n)
     xs = np.array(
-        [brentq(lambda x: fA(np.array([[x, y]]))[0] - fB(np.array([[x, y]]))[0], *xbracket, xtol=1e-15)
-         for y in ys])
+        [
+            brentq(
+                lambda x: fA(np.array([[x, y]]))[0] - fB(np.array([[x, y]]))[0],
+                *xbracket,
+                xtol=1e-15,
+            )
+            for y in ys
+        ]
+    )
     return np.hypot(np.diff(xs), np.diff(ys)).sum()
 
 
 def surface_on(grid_n, A, B, lo, hi, eps):
     nx, ny = grid_n
     g = df.StructuredGrid.uniform(lo, hi, [nx, ny])
-    return g, df.contact_surface(df.levelset_from_shape(g, A), df.levelset_from_shape(g, B), eps=eps)
+    return g, df.contact_surface(
+        df.levelset_from_shape(g, A), df.levelset_from_shape(g, B), eps=eps
+    )
 
 
 def check_surface(s, A, B, grad_exact, xbracket):
@@ -59,8 +68,9 @@ def test_two_circles_unequal_radii():
     A, B = df.Circle(c1, R1), df.Circle(c2, R2)
 
     def grad(x):
-        return ((x - c1) / np.linalg.norm(x - c1, axis=1)[:, None]
-                - (x - c2) / np.linalg.norm(x - c2, axis=1)[:, None])
+        return (x - c1) / np.linalg.norm(x - c1, axis=1)[:, None] - (x - c2) / np.linalg.norm(
+            x - c2, axis=1
+        )[:, None]
 
     res = []
     for n in (100, 200, 400):
@@ -99,8 +109,13 @@ def test_circle_above_box_parabola():
         exact = np.hypot(np.diff(xs), np.diff(ys)).sum()
         ne = grad(x)
         ne /= np.linalg.norm(ne, axis=1)[:, None]
-        res.append((np.abs(A(x) - B(x)).max() / 2,
-                    np.linalg.norm(s["normals"] - ne, axis=1).max(), abs(length - exact) / exact))
+        res.append(
+            (
+                np.abs(A(x) - B(x)).max() / 2,
+                np.linalg.norm(s["normals"] - ne, axis=1).max(),
+                abs(length - exact) / exact,
+            )
+        )
     pos, nerr, lerr = np.array(res).T
     assert rates(pos)[-1] > 1.6 and pos[-1] < 1e-5
     assert rates(nerr)[-1] > 1.6

@@ -22,8 +22,9 @@ def load(name, path):
 
 
 def run(*args):
-    return subprocess.run([sys.executable, str(DEMO), *args], capture_output=True, text=True,
-                          cwd=ROOT)
+    return subprocess.run(
+        [sys.executable, str(DEMO), *args], capture_output=True, text=True, cwd=ROOT
+    )
 
 
 @pytest.fixture(scope="module")
@@ -46,8 +47,11 @@ def test_contract(study):
         assert abs(r["h"] - d["a_hertz"] / r["h_divisor"]) < 1e-12
         assert r["hertz_parameters"]["discretization"] == "cut"
         assert r["num_dofs"] > 0 and r["timing_s"]["total"] > 0
-        assert set(r["errors"]) == {"half_width_rel_error", "peak_pressure_rel_error",
-                                    "pressure_rel_l2_error"}
+        assert set(r["errors"]) == {
+            "half_width_rel_error",
+            "peak_pressure_rel_error",
+            "pressure_rel_l2_error",
+        }
         for f in ("metrics.json", "tractions.csv"):
             assert (out / r["files"] / f).is_file()
     assert (out / "convergence.png").stat().st_size > 0
@@ -69,10 +73,17 @@ def test_errors_decrease(study):
     assert s["check"]["passed"] is True
 
 
-@pytest.mark.parametrize("args,name", [
-    (["--sizes", "10"], "--sizes"), (["--sizes", "10,10"], "--sizes"),
-    (["--sizes", "1,10"], "--sizes"), (["--sizes", "10,x"], "--sizes"),
-    (["--discretization", "p1"], "--discretization"), (["--timeout", "-1"], "--timeout")])
+@pytest.mark.parametrize(
+    "args,name",
+    [
+        (["--sizes", "10"], "--sizes"),
+        (["--sizes", "10,10"], "--sizes"),
+        (["--sizes", "1,10"], "--sizes"),
+        (["--sizes", "10,x"], "--sizes"),
+        (["--discretization", "p1"], "--discretization"),
+        (["--timeout", "-1"], "--timeout"),
+    ],
+)
 def test_bad_input(tmp_path, args, name):
     out = tmp_path / "never"
     r = run(*args, "--out", str(out))

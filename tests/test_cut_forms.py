@@ -26,8 +26,9 @@ E, NU = 3.0, 0.3
 
 def _scene(nx=6, ny=4, levelset=None):
     """A [0,2]x[0,1] quad mesh as a one-body cut scene; levelset(x) -> phi at the vertices."""
-    m = dmesh.create_rectangle(MPI.COMM_WORLD, [[0, 0], [2, 1]], [nx, ny],
-                               dmesh.CellType.quadrilateral)
+    m = dmesh.create_rectangle(
+        MPI.COMM_WORLD, [[0, 0], [2, 1]], [nx, ny], dmesh.CellType.quadrilateral
+    )
     nc = m.topology.index_map(2).size_local + m.topology.index_map(2).num_ghosts
     cells = np.arange(nc, dtype=np.int32)
     Q = fem.FunctionSpace(m, ("Lagrange", 1))
@@ -38,13 +39,20 @@ def _scene(nx=6, ny=4, levelset=None):
     m.topology.create_connectivity(1, 2)
     f2c = m.topology.connectivity(1, 2)
     nf = m.topology.index_map(1).size_local + m.topology.index_map(1).num_ghosts
-    ghost = np.array([f for f in range(nf) if len(f2c.links(f)) == 2
-                      and np.any(kind[f2c.links(f)] == CUT)], np.int32)
-    cut = SimpleNamespace(kind_tags=dmesh.meshtags(m, 2, cells, kind),
-                          ghost_facets=dmesh.meshtags(m, 1, ghost, np.full(len(ghost), GHOST,
-                                                                            np.int32)))
-    scene = SimpleNamespace(mesh=m, cell_tags=dmesh.meshtags(m, 2, cells, np.ones(nc, np.int32)),
-                            cell_type="quadrilateral", cut=cut)
+    ghost = np.array(
+        [f for f in range(nf) if len(f2c.links(f)) == 2 and np.any(kind[f2c.links(f)] == CUT)],
+        np.int32,
+    )
+    cut = SimpleNamespace(
+        kind_tags=dmesh.meshtags(m, 2, cells, kind),
+        ghost_facets=dmesh.meshtags(m, 1, ghost, np.full(len(ghost), GHOST, np.int32)),
+    )
+    scene = SimpleNamespace(
+        mesh=m,
+        cell_tags=dmesh.meshtags(m, 2, cells, np.ones(nc, np.int32)),
+        cell_type="quadrilateral",
+        cut=cut,
+    )
     return scene, phi, kind
 
 
@@ -85,8 +93,9 @@ def test_cut_weights_equal_ffcx_on_uncut_cells():
 def test_cut_energy_equals_sub_triangle_rule():
     # energy of random Q1 fields on a mesh cut by a line and a circle: the moment-fitted
     # weights (FFCx, 3x3 points) and the degree-4 sub-triangle rule are both exact for Q2
-    levelset = lambda x: np.minimum(x[1] - 0.31 * x[0] - 0.43,  # noqa: E731
-                                    np.hypot(x[0] - 1.3, x[1] - 0.2) - 0.3)
+    levelset = lambda x: np.minimum(
+        x[1] - 0.31 * x[0] - 0.43, np.hypot(x[0] - 1.3, x[1] - 0.2) - 0.3  # noqa: E731
+    )
     scene, phi, kind = _scene(8, 5, levelset)
     cut, V, a = _forms(scene, phi)
     A = _matrix(a)
@@ -113,8 +122,9 @@ def test_cut_energy_equals_sub_triangle_rule():
             X, Y = q["points"][:, 0], q["points"][:, 1]
             J = np.column_stack([xg[c, 1] - xg[c, 0], xg[c, 2] - xg[c, 0]])  # affine cell
             # tensor-order Q1 basis derivatives on the reference square, then to x, y
-            dref = np.stack([np.stack([-(1 - Y), 1 - Y, -Y, Y], 1),
-                             np.stack([-(1 - X), -X, 1 - X, X], 1)], 2)  # (np, 4, 2)
+            dref = np.stack(
+                [np.stack([-(1 - Y), 1 - Y, -Y, Y], 1), np.stack([-(1 - X), -X, 1 - X, X], 1)], 2
+            )  # (np, 4, 2)
             dphys = dref @ np.linalg.inv(J)  # rows: grad_X N J^-1 = grad_x N
             uc = w.x.array.reshape(-1, 2)[vdofs[c]]  # (4, 2)
             G = np.einsum("pnd,nc->pcd", dphys, uc)  # (np, 2 components, 2 derivatives)
@@ -131,8 +141,9 @@ def test_body_force_is_the_inside_integral():
     cut, V, _ = _forms(scene, phi)
     v = ufl.TestFunction(V)
     X = ufl.SpatialCoordinate(scene.mesh)
-    b = fem.petsc.assemble_vector(fem.form(ufl.inner(ufl.as_vector((1.0, X[0])), v)
-                                           * cut.measure()))
+    b = fem.petsc.assemble_vector(
+        fem.form(ufl.inner(ufl.as_vector((1.0, X[0])), v) * cut.measure())
+    )
     pdofs = phi.function_space.dofmap.list.array.reshape(len(kind), 4)
     h2 = (2 / 8) * (1 / 5)
     area = h2 * _cpp.inside_fraction(phi.x.array[pdofs]).sum()
@@ -142,8 +153,11 @@ def test_body_force_is_the_inside_integral():
     xg = scene.mesh.geometry.x[scene.mesh.geometry.dofmap.array.reshape(len(kind), 4)]
     cells = np.repeat(np.arange(len(kind)), np.diff(q["offsets"]))
     P = q["points"]
-    x = (xg[cells, 0, 0] + P[:, 0] * (xg[cells, 1, 0] - xg[cells, 0, 0])
-         + P[:, 1] * (xg[cells, 2, 0] - xg[cells, 0, 0]))  # affine map of the tensor cell
+    x = (
+        xg[cells, 0, 0]
+        + P[:, 0] * (xg[cells, 1, 0] - xg[cells, 0, 0])
+        + P[:, 1] * (xg[cells, 2, 0] - xg[cells, 0, 0])
+    )  # affine map of the tensor cell
     moment = h2 * np.dot(q["weights"], x)
     assert f[:, 1].sum() == pytest.approx(moment, rel=1e-12)
 
@@ -151,13 +165,19 @@ def test_body_force_is_the_inside_integral():
 @pytest.mark.parametrize("gamma", [0.0, 0.1])
 def test_rigid_modes_zero_energy_and_ghost_penalty_linear_fields(gamma):
     # a slanted line and a circle cut the cells at arbitrary fractions
-    scene, phi, kind = _scene(8, 5, lambda x: np.minimum(x[1] - 0.31 * x[0] - 0.43,
-                                                           np.hypot(x[0] - 1.3, x[1] - 0.2) - 0.3))
+    scene, phi, kind = _scene(
+        8,
+        5,
+        lambda x: np.minimum(x[1] - 0.31 * x[0] - 0.43, np.hypot(x[0] - 1.3, x[1] - 0.2) - 0.3),
+    )
     assert np.sum(kind == CUT) > 5
     _, V, a = _forms(scene, phi, gamma)
     A = _matrix(a)
-    modes = [lambda x: np.stack([1 + 0 * x[0], 0 * x[0]]), lambda x: np.stack([0 * x[0], 1 + 0 * x[0]]),
-             lambda x: np.stack([-x[1], x[0]])]
+    modes = [
+        lambda x: np.stack([1 + 0 * x[0], 0 * x[0]]),
+        lambda x: np.stack([0 * x[0], 1 + 0 * x[0]]),
+        lambda x: np.stack([-x[1], x[0]]),
+    ]
     r = fem.Function(V)
     y = A.createVecLeft()
     for mode in modes:
@@ -186,17 +206,18 @@ def test_cut_traction_is_the_clipped_facet_integral():
     scene, phi, kind = _scene(6, 4, lambda x: x[1] - 0.53)
     m = scene.mesh
     facets = dmesh.locate_entities_boundary(m, 1, lambda x: np.isclose(x[0], 0.0))
-    scene.facet_tags = dmesh.meshtags(m, 1, np.sort(facets).astype(np.int32),
-                                      np.full(len(facets), 7, np.int32))
+    scene.facet_tags = dmesh.meshtags(
+        m, 1, np.sort(facets).astype(np.int32), np.full(len(facets), 7, np.int32)
+    )
     cut, V, _ = _forms(scene, phi)
     X = ufl.SpatialCoordinate(m)
     b = fem.petsc.assemble_vector(cut.traction_form(V, ufl.as_vector((X[1], X[0] * X[1] + 2)), 7))
     f = b.array.reshape(-1, 2).sum(axis=0)
-    assert f[0] == pytest.approx(0.53 ** 2 / 2, rel=1e-13)
+    assert f[0] == pytest.approx(0.53**2 / 2, rel=1e-13)
     assert f[1] == pytest.approx(2 * 0.53, rel=1e-13)
     # moment about the origin of the x-load: int y * y dy (the Q1 test functions carry it)
     y = V.tabulate_dof_coordinates()[:, 1]
-    assert np.dot(b.array.reshape(-1, 2)[:, 0], y) == pytest.approx(0.53 ** 3 / 3, rel=1e-13)
+    assert np.dot(b.array.reshape(-1, 2)[:, 0], y) == pytest.approx(0.53**3 / 3, rel=1e-13)
 
 
 def test_disc_area_second_order_through_the_binding():

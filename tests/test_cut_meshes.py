@@ -37,29 +37,72 @@ BUILDERS = {
 }
 # name -> {boundary: (body index, [(axis, grid line value)]) or None (cut boundary: no facet)}
 BOUNDARIES = {
-    "hertz": {"block_bottom": (0, [(1, -20.0)]), "block_sides": (0, [(0, -20.0), (0, 20.0)]),
-              "block_top": (0, [(1, 0.0)]), "cylinder_top": (1, [(1, 10.0)]), "cylinder_arc": None},
-    "patch": {"lower_bottom": (0, [(1, 0.0)]), "lower_left": (0, [(0, 0.0)]),
-              "lower_right": (0, [(0, 1.0)]), "lower_top": None, "upper_bottom": None,
-              "upper_left": (1, [(0, 0.0)]), "upper_right": (1, [(0, 1.0)]),
-              "upper_top": (1, [(1, 1.0)])},
-    "two_blocks": {"lower_bottom": (0, [(1, 0.0)]), "lower_left": (0, [(0, 0.0)]),
-                   "lower_right": (0, [(0, 40.0)]), "lower_top": None,
-                   "upper_top": (1, [(1, 20.0)]), "upper_bottom": None,
-                   "upper_sides": (1, [(0, 10.0), (0, 30.0)])},
-    "incline": {"lower_bottom": (0, [(1, 0.0)]), "upper_top": (1, [(1, 1000.0)]),
-                "lower_sides": (0, [(0, 0.0), (0, 1000.0)]),
-                "upper_sides": (1, [(0, 0.0), (0, 1000.0)]), "lower_interface": None,
-                "upper_interface": None},
+    "hertz": {
+        "block_bottom": (0, [(1, -20.0)]),
+        "block_sides": (0, [(0, -20.0), (0, 20.0)]),
+        "block_top": (0, [(1, 0.0)]),
+        "cylinder_top": (1, [(1, 10.0)]),
+        "cylinder_arc": None,
+    },
+    "patch": {
+        "lower_bottom": (0, [(1, 0.0)]),
+        "lower_left": (0, [(0, 0.0)]),
+        "lower_right": (0, [(0, 1.0)]),
+        "lower_top": None,
+        "upper_bottom": None,
+        "upper_left": (1, [(0, 0.0)]),
+        "upper_right": (1, [(0, 1.0)]),
+        "upper_top": (1, [(1, 1.0)]),
+    },
+    "two_blocks": {
+        "lower_bottom": (0, [(1, 0.0)]),
+        "lower_left": (0, [(0, 0.0)]),
+        "lower_right": (0, [(0, 40.0)]),
+        "lower_top": None,
+        "upper_top": (1, [(1, 20.0)]),
+        "upper_bottom": None,
+        "upper_sides": (1, [(0, 10.0), (0, 30.0)]),
+    },
+    "incline": {
+        "lower_bottom": (0, [(1, 0.0)]),
+        "upper_top": (1, [(1, 1000.0)]),
+        "lower_sides": (0, [(0, 0.0), (0, 1000.0)]),
+        "upper_sides": (1, [(0, 0.0), (0, 1000.0)]),
+        "lower_interface": None,
+        "upper_interface": None,
+    },
 }
 # the same names and tags as the gmsh scenes
-TAGS = {"hertz": ["block_bottom", "block_sides", "block_top", "cylinder_top", "cylinder_arc"],
-        "patch": ["lower_bottom", "lower_left", "lower_right", "lower_top", "upper_bottom",
-                  "upper_left", "upper_right", "upper_top"],
-        "two_blocks": ["lower_bottom", "lower_left", "lower_right", "lower_top", "upper_top",
-                       "upper_bottom", "upper_sides"],
-        "incline": ["lower_bottom", "upper_top", "lower_sides", "upper_sides", "lower_interface",
-                    "upper_interface"]}
+TAGS = {
+    "hertz": ["block_bottom", "block_sides", "block_top", "cylinder_top", "cylinder_arc"],
+    "patch": [
+        "lower_bottom",
+        "lower_left",
+        "lower_right",
+        "lower_top",
+        "upper_bottom",
+        "upper_left",
+        "upper_right",
+        "upper_top",
+    ],
+    "two_blocks": [
+        "lower_bottom",
+        "lower_left",
+        "lower_right",
+        "lower_top",
+        "upper_top",
+        "upper_bottom",
+        "upper_sides",
+    ],
+    "incline": [
+        "lower_bottom",
+        "upper_top",
+        "lower_sides",
+        "upper_sides",
+        "lower_interface",
+        "upper_interface",
+    ],
+}
 EDGES = [(0, 1), (0, 2), (1, 3), (2, 3)]  # DOLFINx quadrilateral edges (tensor vertex order)
 _cache = {}
 
@@ -153,8 +196,11 @@ def global_counts(s):
     comm, top = s.mesh.comm, s.mesh.topology
     nc, nf = top.index_map(2).size_local, top.index_map(1).size_local
     tags, kinds = s.cell_tags.values[:nc], s.cut.kind_tags.values[:nc]
-    out = {f"{b.name}/{k}": comm.allreduce(int(np.sum((tags == b.tag) & (kinds == k))))
-           for b in s.bodies for k in (INTERIOR, CUT)}
+    out = {
+        f"{b.name}/{k}": comm.allreduce(int(np.sum((tags == b.tag) & (kinds == k))))
+        for b in s.bodies
+        for k in (INTERIOR, CUT)
+    }
     out["ghost_facets"] = comm.allreduce(int(np.sum(s.cut.ghost_facets.indices < nf)))
     owned_f = s.facet_tags.indices < nf
     for name, tag in s.boundaries.items():
@@ -268,8 +314,12 @@ def test_hertz_geometry():
     assert np.isclose(s.bodies[1].shape(np.zeros((1, 2)))[0], 0.0)
     assert s.h_contact == 0.2 and np.all(np.isin([-10.0, 0.0, 10.0, -1.6, 1.6], s.cut.xlines))
     # facet lengths of the grid-aligned sides
-    for bname, length in [("block_bottom", 40), ("block_sides", 40), ("block_top", 40),
-                          ("cylinder_top", 20)]:
+    for bname, length in [
+        ("block_bottom", 40),
+        ("block_sides", 40),
+        ("block_top", 40),
+        ("cylinder_top", 20),
+    ]:
         p = x[facet_nodes(s, s.facet_tags.indices[s.facet_tags.values == s.boundaries[bname]])]
         assert np.isclose(np.linalg.norm(p[:, 0] - p[:, 1], axis=1).sum(), length), bname
 
@@ -301,8 +351,15 @@ def test_cut_scene_small_and_errors():
     with pytest.raises(ValueError, match="window x bounds"):
         cut_scene(MPI.COMM_SELF, lines, lines, [("a", 1, [[0.1, 0], [1, 1]], circle)], {}, [], 0.25)
     with pytest.raises(ValueError, match="no active cell"):
-        cut_scene(MPI.COMM_SELF, lines, lines, [CutBody("a", 1, np.array([[0, 0], [1, 1]]),
-                                                        df.Circle((5, 5), 0.3))], {}, [], 0.25)
+        cut_scene(
+            MPI.COMM_SELF,
+            lines,
+            lines,
+            [CutBody("a", 1, np.array([[0, 0], [1, 1]]), df.Circle((5, 5), 0.3))],
+            {},
+            [],
+            0.25,
+        )
     with pytest.raises(ValueError, match="grid line"):
         patch_cut_scene(MPI.COMM_SELF, n=4)  # interface 0.5 on a line
     s = cut_scene(MPI.COMM_SELF, lines, lines, [("a", 1, [[0, 0], [1, 1]], circle)], {}, [], 0.25)
@@ -311,8 +368,15 @@ def test_cut_scene_small_and_errors():
     assert np.allclose(s.bodies[0].bbox, [[0.05, 0.05], [0.95, 0.95]])  # from the grid crossings
     # the zero contour on a grid line: cells touching it from inside are interior, the ones
     # beyond (phi = 0 at their lowest vertices) are not active: no cut cell at all
-    s = cut_scene(MPI.COMM_SELF, lines, lines,
-                  [("a", 1, [[0, 0], [1, 1]], half_plane((0, 0.5), (0, 1), 10))], {}, [], 0.25)
+    s = cut_scene(
+        MPI.COMM_SELF,
+        lines,
+        lines,
+        [("a", 1, [[0, 0], [1, 1]], half_plane((0, 0.5), (0, 1), 10))],
+        {},
+        [],
+        0.25,
+    )
     _, _, _, kinds = check_local(s)
     assert len(kinds) == 8 and np.all(kinds == INTERIOR) and len(s.cut.ghost_facets.indices) == 0
     assert np.allclose(s.bodies[0].bbox, [[0, 0], [1, 0.5]])
@@ -329,8 +393,15 @@ def two_rank_report(comm):
         patch_cut_scene(comm, n=4)
     with pytest.raises(ValueError, match="no active cell"):
         lines = np.linspace(0, 1, 3)
-        cut_scene(comm, lines, lines, [("a", 1, [[0, 0], [1, 1]], half_plane((0, -1), (0, 1), 9))],
-                  {}, [], 0.5)
+        cut_scene(
+            comm,
+            lines,
+            lines,
+            [("a", 1, [[0, 0], [1, 1]], half_plane((0, -1), (0, 1), 9))],
+            {},
+            [],
+            0.5,
+        )
     report = {}
     for name, build in BUILDERS.items():
         s = build(comm)
@@ -362,8 +433,13 @@ def test_two_ranks_match_one_rank():
     if mpirun is None or MPI.COMM_WORLD.size > 1:
         pytest.skip("no mpirun, or already under mpirun (no nested launch)")
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    r = subprocess.run([mpirun, "--oversubscribe", "-n", "2", sys.executable, __file__],
-                       capture_output=True, text=True, env=env, timeout=120)
+    r = subprocess.run(
+        [mpirun, "--oversubscribe", "-n", "2", sys.executable, __file__],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
     _compare(json.loads(r.stdout.strip().splitlines()[-1]))
 

@@ -36,8 +36,7 @@ def inside_loops(phi):
 
     def crossing(a, b):
         s = f[a] / (f[a] - f[b])
-        return tuple(sp.Rational(c[0]) + s * (c[1] - c[0])
-                     for c in zip(CORNERS[a], CORNERS[b]))
+        return tuple(sp.Rational(c[0]) + s * (c[1] - c[0]) for c in zip(CORNERS[a], CORNERS[b]))
 
     poly, cross_at = [], {}
     for k in range(4):
@@ -51,8 +50,11 @@ def inside_loops(phi):
         return []
     if len(cross_at) == 4 and sum(f) / 4 >= 0:
         # saddle, centre outside: each inside corner with its two neighbouring crossings
-        return [[cross_at[(k - 1) % 4], CORNERS[CCW[k]], cross_at[k]]
-                for k in range(4) if inside[CCW[k]]]
+        return [
+            [cross_at[(k - 1) % 4], CORNERS[CCW[k]], cross_at[k]]
+            for k in range(4)
+            if inside[CCW[k]]
+        ]
     return [poly]
 
 
@@ -65,8 +67,9 @@ def exact_integral(p, loops):
             dy = sp.Rational(Q[1]) - P[1]
             if dy == 0:
                 continue
-            g = sp.Poly(G.subs({X: P[0] + T * (Q[0] - P[0]), Y: P[1] + T * dy}, simultaneous=True)
-                        * dy, T).integrate()
+            g = sp.Poly(
+                G.subs({X: P[0] + T * (Q[0] - P[0]), Y: P[1] + T * dy}, simultaneous=True) * dy, T
+            ).integrate()
             total += g.eval(1) - g.eval(0)
     return total
 
@@ -75,8 +78,9 @@ def random_poly(rng, m):
     """A random polynomial in Q_{m-1}: sympy expression and numpy evaluator."""
     c = rng.uniform(-1, 1, (m, m))
     expr = sum(sp.Rational(c[a, b]) * X**a * Y**b for a in range(m) for b in range(m))
-    return expr, lambda x: np.einsum("ab,ka,kb->k", c, x[:, :1] ** np.arange(m),
-                                      x[:, 1:] ** np.arange(m))
+    return expr, lambda x: np.einsum(
+        "ab,ka,kb->k", c, x[:, :1] ** np.arange(m), x[:, 1:] ** np.arange(m)
+    )
 
 
 def vertex_values(fn):
@@ -137,8 +141,9 @@ def test_weights_integrate_tensor_polynomials_exactly(q, family):
         assert area == pytest.approx(_cpp.inside_fraction(phi[None])[0], rel=1e-13, abs=1e-16)
         for _ in range(2):
             expr, f = random_poly(rng, m)
-            assert w @ f(x) == pytest.approx(float(exact_integral(expr, loops)), rel=1e-13,
-                                             abs=1e-14)
+            assert w @ f(x) == pytest.approx(
+                float(exact_integral(expr, loops)), rel=1e-13, abs=1e-14
+            )
 
 
 @pytest.mark.parametrize("q", [2, 4, 6])
@@ -155,10 +160,12 @@ def test_tiny_cuts_exact_and_bounded_weights(q):
     for e in range(2, 9):
         a = 10.0**-e
         s = np.sqrt(2 * a)
-        for phi, rel, ab in [([-s, 1 - s, 1 - s, 2 - s], 1e-12, 0),
-                             ([2 - s, 1 - s, 1 - s, -s], 1e-12, 0),
-                             ([-a, 1 - a, -a, 1 - a], 1e-13, 1e-15),
-                             ([1 - a, -a, 1 - a, -a], 1e-13, 1e-15)]:
+        for phi, rel, ab in [
+            ([-s, 1 - s, 1 - s, 2 - s], 1e-12, 0),
+            ([2 - s, 1 - s, 1 - s, -s], 1e-12, 0),
+            ([-a, 1 - a, -a, 1 - a], 1e-13, 1e-15),
+            ([1 - a, -a, 1 - a, -a], 1e-13, 1e-15),
+        ]:
             phi = np.array(phi)
             w = _cpp.cut_moment_weights(phi[None], x)[0]
             area = float(exact_integral(sp.Integer(1), inside_loops(phi)))
@@ -205,8 +212,10 @@ def test_elastic_energy_of_q1_fields_exact_with_three_points():
     u = [sum(sp.Rational(U[n, i]) * N[n] for n in range(4)) for i in range(2)]
     g = [[sp.diff(u[i], X) / hx, sp.diff(u[i], Y) / hy] for i in range(2)]  # grad u, physical
     eps = [[(g[i][j] + g[j][i]) / 2 for j in range(2)] for i in range(2)]
-    psi = sp.expand(mu * sum(eps[i][j] ** 2 for i in range(2) for j in range(2))
-                    + lmbda / 2 * (eps[0][0] + eps[1][1]) ** 2)  # in Q2
+    psi = sp.expand(
+        mu * sum(eps[i][j] ** 2 for i in range(2) for j in range(2))
+        + lmbda / 2 * (eps[0][0] + eps[1][1]) ** 2
+    )  # in Q2
     exact = float(exact_integral(psi, inside_loops(phi)) * hx * hy)
     psi_np = sp.lambdify((X, Y), psi, "numpy")
     errors = {}
@@ -225,8 +234,14 @@ def test_elastic_energy_of_q1_fields_exact_with_three_points():
     hxf, hyf, muf, lf = (float(v) for v in (hx, hy, mu, lmbda))
     K = np.zeros((8, 8))
     for (Xk, Yk), wk in zip(x, w):
-        dN = np.array([[-(1 - Yk) / hxf, -(1 - Xk) / hyf], [(1 - Yk) / hxf, -Xk / hyf],
-                       [-Yk / hxf, (1 - Xk) / hyf], [Yk / hxf, Xk / hyf]])
+        dN = np.array(
+            [
+                [-(1 - Yk) / hxf, -(1 - Xk) / hyf],
+                [(1 - Yk) / hxf, -Xk / hyf],
+                [-Yk / hxf, (1 - Xk) / hyf],
+                [Yk / hxf, Xk / hyf],
+            ]
+        )
         B = np.zeros((3, 8))  # Voigt (exx, eyy, 2 exy), dof = node * 2 + component
         B[0, 0::2], B[1, 1::2] = dN[:, 0], dN[:, 1]
         B[2, 0::2], B[2, 1::2] = dN[:, 1], dN[:, 0]
@@ -240,11 +255,15 @@ def test_factors_follow_ffcx_points_in_a_quadrature_function():
     """End to end, as dolfinx_forms.cut uses the weights: factor W_k / w_k in a Quadrature
     function (dof k <-> basix point k), phi from the P1 dofmap (reference vertex order)."""
     q = 4
-    msh = dmesh.create_rectangle(MPI.COMM_WORLD, [[0, 0], [2, 1]], [2, 2],
-                                 dmesh.CellType.quadrilateral)
+    msh = dmesh.create_rectangle(
+        MPI.COMM_WORLD, [[0, 0], [2, 1]], [2, 2], dmesh.CellType.quadrilateral
+    )
     points, wref = _gauss(q)
-    F = fem.Function(fem.FunctionSpace(msh, ufl.FiniteElement("Quadrature", msh.ufl_cell(), q,
-                                                              quad_scheme="default")))
+    F = fem.Function(
+        fem.FunctionSpace(
+            msh, ufl.FiniteElement("Quadrature", msh.ufl_cell(), q, quad_scheme="default")
+        )
+    )
     P = fem.FunctionSpace(msh, ("Lagrange", 1))
     phi = fem.Function(P)
     phi.interpolate(lambda x: 0.9 * x[0] + 0.35 * x[1] - 1.1)
@@ -253,8 +272,9 @@ def test_factors_follow_ffcx_points_in_a_quadrature_function():
     W = _cpp.cut_moment_weights(pv, points)
     F.x.array[F.function_space.dofmap.list.array.reshape(-1, len(wref))[:ncells]] = W / wref
     x = ufl.SpatialCoordinate(msh)
-    value = fem.assemble_scalar(fem.form(F * x[0] ** 2 * x[1] * ufl.dx(
-        metadata={"quadrature_degree": q})))
+    value = fem.assemble_scalar(
+        fem.form(F * x[0] ** 2 * x[1] * ufl.dx(metadata={"quadrature_degree": q}))
+    )
     # exact: per cell, the reference polygon, the bilinear geometry map and |det J|
     N = [(1 - X) * (1 - Y), X * (1 - Y), (1 - X) * Y, X * Y]
     exact = sp.Integer(0)

@@ -15,13 +15,20 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 BLOCKS = ROOT / "demos" / "two_blocks.py"
 INCLINE = ROOT / "demos" / "inclined_interface.py"
-CONTRACT_RESULTS = ("reaction", "contact_half_width", "peak_pressure", "stick_half_width",
-                    "pressure_rel_l2_error", "traction_rel_l2_error")
+CONTRACT_RESULTS = (
+    "reaction",
+    "contact_half_width",
+    "peak_pressure",
+    "stick_half_width",
+    "pressure_rel_l2_error",
+    "traction_rel_l2_error",
+)
 
 
 def run(demo, *args):
-    return subprocess.run([sys.executable, str(demo), *args], capture_output=True, text=True,
-                          cwd=ROOT, timeout=120)
+    return subprocess.run(
+        [sys.executable, str(demo), *args], capture_output=True, text=True, cwd=ROOT, timeout=120
+    )
 
 
 def load(out):
@@ -142,9 +149,15 @@ def test_blocks_cut_matches_conforming(blocks, mu):
     assert abs(mc["results"]["reaction"][1] / mg["results"]["reaction"][1] - 1) < 0.005
 
 
-@pytest.mark.parametrize("bad, name", [(("--mu", "-1"), "--mu"), (("--nu", "0.5"), "--nu"),
-                                       (("--discretization", "cut", "--degree", "2"), "--degree"),
-                                       (("--discretization", "mesh"), "--discretization")])
+@pytest.mark.parametrize(
+    "bad, name",
+    [
+        (("--mu", "-1"), "--mu"),
+        (("--nu", "0.5"), "--nu"),
+        (("--discretization", "cut", "--degree", "2"), "--degree"),
+        (("--discretization", "mesh"), "--discretization"),
+    ],
+)
 def test_blocks_bad_input_one_line_exit_2(tmp_path, bad, name):
     out = tmp_path / "never"
     r = run(BLOCKS, "--out", str(out), *bad)
@@ -182,9 +195,15 @@ def test_incline_slips_iff_mu_below_tan_theta(tmp_path, mu, slips, disc):
     assert (out / "slip.png").stat().st_size > 0
 
 
-@pytest.mark.parametrize("bad, name", [(("--h", "0"), "--h"), (("--nu", "0.5"), "--nu"),
-                                       (("--mu", "-0.1"), "--mu"),
-                                       (("--discretization", "cut", "--degree", "2"), "--degree")])
+@pytest.mark.parametrize(
+    "bad, name",
+    [
+        (("--h", "0"), "--h"),
+        (("--nu", "0.5"), "--nu"),
+        (("--mu", "-0.1"), "--mu"),
+        (("--discretization", "cut", "--degree", "2"), "--degree"),
+    ],
+)
 def test_incline_bad_input_one_line_exit_2(tmp_path, bad, name):
     out = tmp_path / "never"
     r = run(INCLINE, "--out", str(out), *bad)

@@ -30,13 +30,22 @@ def test_demo_outputs_match_exact_gap(tmp_path):
     c = np.array([0.0, R + gap])
     n_cyl = (data[:, :2] - c) / np.linalg.norm(data[:, :2] - c, axis=1)[:, None]
     exact = y * np.linalg.norm(np.array([0.0, 1.0]) - n_cyl, axis=1)
-    assert np.abs(g_n0 - exact).max() < 0.02 * h**2  # chord error ~ h^2/(8 R_eff) measured 8e-3 h^2
+    assert (
+        np.abs(g_n0 - exact).max() < 0.02 * h**2
+    )  # chord error ~ h^2/(8 R_eff) measured 8e-3 h^2
     assert g_n0.min() == pytest.approx(gap, rel=1e-3)  # at the apex the gap is the given gap
     assert (out / "contact_geometry.png").stat().st_size > 0
 
 
-@pytest.mark.parametrize("bad, name", [(("--R", "-1"), "--R"), (("--h", "0"), "--h"),
-                                       (("--gap", "nan"), "--gap"), (("--bogus", "1"), "bogus")])
+@pytest.mark.parametrize(
+    "bad, name",
+    [
+        (("--R", "-1"), "--R"),
+        (("--h", "0"), "--h"),
+        (("--gap", "nan"), "--gap"),
+        (("--bogus", "1"), "bogus"),
+    ],
+)
 def test_bad_input_one_line_exit_2_nothing_written(tmp_path, bad, name):
     out = tmp_path / "never"
     r = run("--out", str(out), *bad)

@@ -18,8 +18,12 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def run(demo, out, *args):
-    r = subprocess.run([sys.executable, str(ROOT / "demos" / demo), "--out", str(out), *args],
-                       capture_output=True, text=True, cwd=ROOT)
+    r = subprocess.run(
+        [sys.executable, str(ROOT / "demos" / demo), "--out", str(out), *args],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
     return r
 
 
@@ -53,9 +57,10 @@ def test_hertz_cut_matches_gmsh(hertz, tmp_path_factory):
         pytest.skip("compares the cut run with the conforming one")
     from dolfinx_forms.output import window_average
 
-    cut, gmsh = (np.genfromtxt(d / "tractions.csv", delimiter=",", names=True, dtype=None,
-                               encoding=None)
-                 for d in (hertz, hertz_run(tmp_path_factory, "conforming")))
+    cut, gmsh = (
+        np.genfromtxt(d / "tractions.csv", delimiter=",", names=True, dtype=None, encoding=None)
+        for d in (hertz, hertz_run(tmp_path_factory, "conforming"))
+    )
     assert np.allclose(cut["x"], gmsh["x"], atol=1e-12)
     h = metrics(hertz)["mesh"]["h_contact"]
     pc, pg = (window_average(d["x"], d["p_n"], h) for d in (cut, gmsh))
@@ -95,8 +100,9 @@ def test_newton_converges_quadratically(hertz):
 def test_tractions_csv_contract(hertz):
     lines = (hertz / "tractions.csv").read_text().splitlines()
     assert lines[0] == "x,y,p_n,p_t,gap_n,slip,state"
-    data = np.genfromtxt(hertz / "tractions.csv", delimiter=",", names=True, dtype=None,
-                         encoding=None)
+    data = np.genfromtxt(
+        hertz / "tractions.csv", delimiter=",", names=True, dtype=None, encoding=None
+    )
     assert set(data["state"]) <= {"open", "stick", "slip"}
     active = data["state"] != "open"
     # half-width from the active points, as in metrics.json
@@ -117,9 +123,16 @@ def test_mindlin_stick_zone(tmp_path, disc):
     assert res["traction_rel_l2_error"] <= 0.08
 
 
-@pytest.mark.parametrize("args", [[], ["--triangles"], ["--discretization", "cut"],
-                                  ["--discretization", "cut", "--interface", "0.5000001"],
-                                  ["--discretization", "cut", "--h", "0.2", "--interface", "0.77"]])
+@pytest.mark.parametrize(
+    "args",
+    [
+        [],
+        ["--triangles"],
+        ["--discretization", "cut"],
+        ["--discretization", "cut", "--interface", "0.5000001"],
+        ["--discretization", "cut", "--h", "0.2", "--interface", "0.77"],
+    ],
+)
 def test_patch_test_exact(tmp_path, args):
     out = tmp_path / "patch"
     r = run("patch_test.py", out, *args)
@@ -132,8 +145,14 @@ def test_patch_test_exact(tmp_path, args):
     assert an["pressure"] == pytest.approx(0.010989011, rel=1e-8)
 
 
-@pytest.mark.parametrize("args", [[], ["--discretization", "cut", "--interface", "0.3141"],
-                                  ["--discretization", "cut", "--interface", "0.6251"]])
+@pytest.mark.parametrize(
+    "args",
+    [
+        [],
+        ["--discretization", "cut", "--interface", "0.3141"],
+        ["--discretization", "cut", "--interface", "0.6251"],
+    ],
+)
 def test_patch_test_stiff_penalty_tends_to_exact(tmp_path, args):
     """eps0 = 1e-6: the penalised pressure is 1.4e-7 from 0.010989011 (eq 51 compliance)."""
     out = tmp_path / "patch"
@@ -141,21 +160,24 @@ def test_patch_test_stiff_penalty_tends_to_exact(tmp_path, args):
     assert metrics(out)["results"]["pressure_rel_error_vs_exact"] <= 1e-6
 
 
-@pytest.mark.parametrize("demo,args,name", [
-    ("hertz.py", ["--E", "-1"], "--E"),
-    ("hertz.py", ["--nu", "0.5"], "--nu"),
-    ("hertz.py", ["--mu", "-0.1"], "--mu"),
-    ("hertz.py", ["--h", "0"], "--h"),
-    ("hertz.py", ["--R", "nan"], "--R"),
-    ("hertz.py", ["--bogus", "1"], "--bogus"),
-    ("hertz.py", ["--tangential", "0.5"], "--tangential"),
-    ("patch_test.py", ["--h", "0.3"], "--h"),
-    ("patch_test.py", ["--nu", "0.7"], "--nu"),
-    ("patch_test.py", ["--discretization", "cut", "--interface", "0.5"], "--interface"),
-    ("patch_test.py", ["--interface", "0.3"], "--interface"),
-    ("hertz.py", ["--discretization", "cut", "--degree", "2"], "--degree"),
-    ("hertz.py", ["--discretization", "cut", "--ghost-penalty", "-1"], "--ghost-penalty"),
-])
+@pytest.mark.parametrize(
+    "demo,args,name",
+    [
+        ("hertz.py", ["--E", "-1"], "--E"),
+        ("hertz.py", ["--nu", "0.5"], "--nu"),
+        ("hertz.py", ["--mu", "-0.1"], "--mu"),
+        ("hertz.py", ["--h", "0"], "--h"),
+        ("hertz.py", ["--R", "nan"], "--R"),
+        ("hertz.py", ["--bogus", "1"], "--bogus"),
+        ("hertz.py", ["--tangential", "0.5"], "--tangential"),
+        ("patch_test.py", ["--h", "0.3"], "--h"),
+        ("patch_test.py", ["--nu", "0.7"], "--nu"),
+        ("patch_test.py", ["--discretization", "cut", "--interface", "0.5"], "--interface"),
+        ("patch_test.py", ["--interface", "0.3"], "--interface"),
+        ("hertz.py", ["--discretization", "cut", "--degree", "2"], "--degree"),
+        ("hertz.py", ["--discretization", "cut", "--ghost-penalty", "-1"], "--ghost-penalty"),
+    ],
+)
 def test_bad_input(tmp_path, demo, args, name):
     out = tmp_path / "never"
     r = run(demo, out, *args)

@@ -24,19 +24,33 @@ def block_scene(n=16, cell=dmesh.CellType.triangle):
     values = np.ones(ncells, np.int32)
     body = Body("block", 1, Box([-W / 2, 0], [W / 2, H]), np.array([[-W / 2, 0], [W / 2, H]]))
     tol = 1e-9
-    markers = {"bottom": (1, lambda x: np.isclose(x[1], 0, atol=tol)),
-               "punch": (2, lambda x: np.isclose(x[1], H, atol=tol) & (np.abs(x[0]) <= A + tol))}
+    markers = {
+        "bottom": (1, lambda x: np.isclose(x[1], 0, atol=tol)),
+        "punch": (2, lambda x: np.isclose(x[1], H, atol=tol) & (np.abs(x[0]) <= A + tol)),
+    }
     facet_tags, boundaries = tag_boundaries(m, values, [body], markers)
     cell_tags = dmesh.meshtags(m, 2, np.arange(ncells, dtype=np.int32), values)
-    return Scene(m, cell_tags, facet_tags, boundaries, [body], [], H / n,
-                 "triangle" if cell == dmesh.CellType.triangle else "quadrilateral")
+    return Scene(
+        m,
+        cell_tags,
+        facet_tags,
+        boundaries,
+        [body],
+        [],
+        H / n,
+        "triangle" if cell == dmesh.CellType.triangle else "quadrilateral",
+    )
 
 
 def punch(scene, law, depth, steps=1):
-    bcs = [Dirichlet("bottom", None, 0.0), Dirichlet("punch", 0, 0.0),
-           Dirichlet("punch", 1, lambda lam: -lam * depth)]
-    p = ContactProblem(scene, {1: law}, dirichlet=bcs, newton=NewtonOptions(rtol=1e-11),
-                       log=lambda *a: None)
+    bcs = [
+        Dirichlet("bottom", None, 0.0),
+        Dirichlet("punch", 0, 0.0),
+        Dirichlet("punch", 1, lambda lam: -lam * depth),
+    ]
+    p = ContactProblem(
+        scene, {1: law}, dirichlet=bcs, newton=NewtonOptions(rtol=1e-11), log=lambda *a: None
+    )
     p.solve(steps)
     return p
 
@@ -106,24 +120,39 @@ def cut_block_scene():
 
     from dolfinx_forms import scene_spec
 
-    spec = scene_spec.load({
-        "name": "cut_punch",
-        "discretization": {"kind": "cut", "h": 1 / 16, "extent": [[-W / 2, 0.0], [W / 2, H]]},
-        "bodies": [{"name": "block", "window": [[-W / 2, 0.0], [W / 2, H]],
+    spec = scene_spec.load(
+        {
+            "name": "cut_punch",
+            "discretization": {"kind": "cut", "h": 1 / 16, "extent": [[-W / 2, 0.0], [W / 2, H]]},
+            "bodies": [
+                {
+                    "name": "block",
+                    "window": [[-W / 2, 0.0], [W / 2, H]],
                     "shape": {"type": "half_plane", "point": [0.0, 0.1], "normal": [0.1, -1.0]},
-                    "law": {"type": "linear", "E": E, "nu": NU}}],
-        "boundaries": [{"name": "sides", "body": "block", "side": ["left", "right"]},
-                       {"name": "punch", "box": {"x_min": -A, "x_max": A, "y_min": H - 1e-9,
-                                                 "y_max": H + 1e-9}}],
-    })
+                    "law": {"type": "linear", "E": E, "nu": NU},
+                }
+            ],
+            "boundaries": [
+                {"name": "sides", "body": "block", "side": ["left", "right"]},
+                {
+                    "name": "punch",
+                    "box": {"x_min": -A, "x_max": A, "y_min": H - 1e-9, "y_max": H + 1e-9},
+                },
+            ],
+        }
+    )
     return build_scene(MPI.COMM_WORLD, spec)
 
 
 def cut_punch(scene, law, depth):
-    bcs = [Dirichlet("sides", None, 0.0), Dirichlet("punch", 0, 0.0),
-           Dirichlet("punch", 1, lambda lam: -lam * depth)]
-    p = ContactProblem(scene, {1: law}, dirichlet=bcs, newton=NewtonOptions(rtol=1e-11),
-                       log=lambda *a: None)
+    bcs = [
+        Dirichlet("sides", None, 0.0),
+        Dirichlet("punch", 0, 0.0),
+        Dirichlet("punch", 1, lambda lam: -lam * depth),
+    ]
+    p = ContactProblem(
+        scene, {1: law}, dirichlet=bcs, newton=NewtonOptions(rtol=1e-11), log=lambda *a: None
+    )
     p.solve(1)
     return p
 

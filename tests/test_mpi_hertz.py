@@ -22,9 +22,15 @@ def reaction(comm, mu, disc="conforming"):
     mat = {b.tag: (1e4, 0.3) for b in scene.bodies}
     top_x = Dirichlet("cylinder_top", 0, 0.0)
     top_y = Dirichlet("cylinder_top", 1, lambda lam: -0.15 * lam)
-    p = ContactProblem(scene, mat, mu=0.0, eps0=0.5, band=0.13,
-                       dirichlet=[Dirichlet("block_bottom", None, 0.0), top_x, top_y],
-                       log=lambda *a: None)
+    p = ContactProblem(
+        scene,
+        mat,
+        mu=0.0,
+        eps0=0.5,
+        band=0.13,
+        dirichlet=[Dirichlet("block_bottom", None, 0.0), top_x, top_y],
+        log=lambda *a: None,
+    )
     p.solve(2)
     if mu > 0:  # a frictional tangential step: history and stick/slip in parallel too
         p.set_friction(mu)
@@ -36,8 +42,9 @@ def reaction(comm, mu, disc="conforming"):
 
 
 @pytest.mark.mpi
-@pytest.mark.parametrize("mu,disc", [(0.0, "conforming"), (0.3, "conforming"), (0.0, "cut"),
-                                     (0.3, "cut")])
+@pytest.mark.parametrize(
+    "mu,disc", [(0.0, "conforming"), (0.3, "conforming"), (0.0, "cut"), (0.3, "cut")]
+)
 def test_two_ranks_match_one(mu, disc):
     world = MPI.COMM_WORLD
     assert world.size == 2, "run under mpirun -n 2"

@@ -48,18 +48,31 @@ def _a(study, h):
     return study["runs"][("fitted", h)]["half_width"]
 
 
-@pytest.mark.parametrize("key,C", [("reaction_rel_diff", 0.03), ("half_width_rel_diff", 0.15),
-                                   ("half_width_moment_rel_diff", 0.015),
-                                   ("pressure_rel_l2_diff", 1.0),
-                                   ("pressure_rel_l2_diff_averaged", 0.15)])
+@pytest.mark.parametrize(
+    "key,C",
+    [
+        ("reaction_rel_diff", 0.03),
+        ("half_width_rel_diff", 0.15),
+        ("half_width_moment_rel_diff", 0.015),
+        ("pressure_rel_l2_diff", 1.0),
+        ("pressure_rel_l2_diff_averaged", 0.15),
+    ],
+)
 def test_paths_agree_within_discretisation_error(study, key, C):
     for h, c in zip(HS, study["comps"]):
         assert c[key] <= C * h / _a(study, h), (key, h, c[key])
 
 
-@pytest.mark.parametrize("key", ["reaction_rel_diff", "half_width_rel_diff",
-                                 "half_width_moment_rel_diff", "pressure_rel_l2_diff",
-                                 "pressure_rel_l2_diff_averaged"])
+@pytest.mark.parametrize(
+    "key",
+    [
+        "reaction_rel_diff",
+        "half_width_rel_diff",
+        "half_width_moment_rel_diff",
+        "pressure_rel_l2_diff",
+        "pressure_rel_l2_diff_averaged",
+    ],
+)
 def test_path_difference_decreases_with_h(study, key):
     d = [c[key] for c in study["comps"]]
     for coarse, fine in zip(d[:-1], d[1:]):

@@ -20,8 +20,11 @@ def test_library_does_not_import_meshes():
     The application layer (app.py, __main__.py: run a description with the scene builders)
     sits on top of both and is the one exception."""
     pattern = re.compile(r"^\s*(from\s+meshes(\.|\s)|import\s+meshes\b)", re.M)
-    files = [f for f in sorted((ROOT / "dolfinx_forms").glob("*.py"))
-             if f.name not in ("app.py", "__main__.py")]
+    files = [
+        f
+        for f in sorted((ROOT / "dolfinx_forms").glob("*.py"))
+        if f.name not in ("app.py", "__main__.py")
+    ]
     assert len(files) > 5
     bad = [f.name for f in files if pattern.search(f.read_text())]
     assert bad == [], f"dolfinx_forms modules importing meshes: {bad}"

@@ -36,8 +36,9 @@ def test_exact_shapes_project_exactly_and_g_n0_is_eq_28(hertz):
     assert all(has_exact_shape(b) for b in scene.bodies)
     assert on_circle(g.p_j).max() < 1e-10  # exact projection onto the cylinder (to rtol h)
     np.testing.assert_allclose(g.p_i[:, 1], 0.0, atol=1e-10)  # and onto the block's top
-    np.testing.assert_allclose(g.g_n0, np.einsum("ij,ij->i", g.p_j - g.p_i, g.normals),
-                               rtol=0, atol=1e-15)
+    np.testing.assert_allclose(
+        g.g_n0, np.einsum("ij,ij->i", g.p_j - g.p_i, g.normals), rtol=0, atol=1e-15
+    )
     # eq 25 on the grid level sets: the same points to the interpolation error
     gl = pair_geometry(V, scene, (0, 1), 0.2, projection="levelset")
     np.testing.assert_array_equal(gl.points, g.points)
@@ -58,10 +59,15 @@ def test_body_without_exact_shape_uses_eq_25_on_its_level_set(hertz):
     pair_grid = df.StructuredGrid.uniform([-1.0, -0.5], [1.0, 0.5], [80, 40])
     phi_pair = body_levelset(pair_grid, grid_body)
     for got, want in (
-            (closest_points(cyl, phi_pair, pts, 0.1),
-             _cpp.closest_point_projection(cyl.shape, pts, 0.1)),
-            (closest_points(grid_body, phi_pair, pts, 0.1),
-             _cpp.closest_point_projection(phi_pair, pts))):
+        (
+            closest_points(cyl, phi_pair, pts, 0.1),
+            _cpp.closest_point_projection(cyl.shape, pts, 0.1),
+        ),
+        (
+            closest_points(grid_body, phi_pair, pts, 0.1),
+            _cpp.closest_point_projection(phi_pair, pts),
+        ),
+    ):
         np.testing.assert_array_equal(got["points"], want["points"])
     # end to end through pair_geometry
     scene2 = dataclasses.replace(scene, bodies=[scene.bodies[0], grid_body])
@@ -69,22 +75,31 @@ def test_body_without_exact_shape_uses_eq_25_on_its_level_set(hertz):
     assert len(g.weights) > 10
     assert on_circle(g.p_j).max() < 1e-6  # eq 25 on the interpolant, not exact
     exact = pair_geometry(V, scene, (0, 1), 0.2)
-    np.testing.assert_allclose(g.g_n0, np.einsum("ij,ij->i", g.p_j - g.p_i, g.normals),
-                               rtol=0, atol=1e-15)
+    np.testing.assert_allclose(
+        g.g_n0, np.einsum("ij,ij->i", g.p_j - g.p_i, g.normals), rtol=0, atol=1e-15
+    )
     order = np.argsort(exact.points[:, 0])
     g0 = np.interp(g.points[:, 0], exact.points[order, 0], exact.g_n0[order])
     assert np.abs(g.g_n0 - g0).max() < 1e-5
     # a level set that does not cover the search box is named
-    short = dataclasses.replace(cyl, shape=df.levelset_from_shape(
-        df.StructuredGrid.uniform([-1.0, -0.6], [1.0, 0.6], [100, 60]), cyl.shape))
+    short = dataclasses.replace(
+        cyl,
+        shape=df.levelset_from_shape(
+            df.StructuredGrid.uniform([-1.0, -0.6], [1.0, 0.6], [100, 60]), cyl.shape
+        ),
+    )
     with pytest.raises(ValueError, match="does not cover"):
         pair_geometry(V, dataclasses.replace(scene, bodies=[scene.bodies[0], short]), (0, 1), 0.2)
 
 
 def test_cell_contours_binding():
-    phi = np.array([[-0.3, 0.7, -0.1, 0.9],      # one segment, bottom to top
-                    [0.25, -0.25, -0.25, 0.25],  # saddle, centre 0 (outside): v1, v2 cut off
-                    [1.0, 2.0, 3.0, 4.0]])       # outside
+    phi = np.array(
+        [
+            [-0.3, 0.7, -0.1, 0.9],  # one segment, bottom to top
+            [0.25, -0.25, -0.25, 0.25],  # saddle, centre 0 (outside): v1, v2 cut off
+            [1.0, 2.0, 3.0, 4.0],
+        ]
+    )  # outside
     c = _cpp.cell_contours(phi)
     np.testing.assert_array_equal(c["num_segments"], [1, 2, 0])
     np.testing.assert_allclose(c["t"][0], [0.3, np.nan, 0.1, np.nan])

@@ -90,8 +90,10 @@ def test_matches_numpy_reference(tdim, eps_n, eps_t, mu):
     nt = np.linalg.norm(r["tau_t"], axis=1)
     assert np.all(nt <= bound * (1 + 1e-14))
     np.testing.assert_allclose(nt[r["state"] == SLIP], bound[r["state"] == SLIP], rtol=1e-14)
-    tol = 8 * np.finfo(float).eps * (
-        (np.abs(g_t) + np.abs(gtp) + np.abs(r["gtp_trial"])) / eps_t + np.abs(r["tau_t"])
+    tol = (
+        8
+        * np.finfo(float).eps
+        * ((np.abs(g_t) + np.abs(gtp) + np.abs(r["gtp_trial"])) / eps_t + np.abs(r["tau_t"]))
     )
     assert np.all(np.abs(r["tau_t"] - (g_t - r["gtp_trial"]) / eps_t) <= tol)
 
@@ -154,8 +156,12 @@ def test_hand_values_2d():
     # tau_n = -2, mu|tau_n| = 1; point 0: tau_tr = 2 -> slip; point 1: tau_tr = 0.8 -> stick;
     # point 2: open. Binary-exact up to one rounding: 1e-14 absolute on O(1) values.
     r = _cpp.return_mapping(
-        np.array([-1.0, -1.0, 0.0]), np.array([0.6, 0.3, 0.2]), np.array([0.1, 0.1, 0.4]),
-        0.5, 0.25, 0.5,
+        np.array([-1.0, -1.0, 0.0]),
+        np.array([0.6, 0.3, 0.2]),
+        np.array([0.1, 0.1, 0.4]),
+        0.5,
+        0.25,
+        0.5,
     )
     np.testing.assert_array_equal(r["state"], [SLIP, STICK, OPEN])
     np.testing.assert_allclose(r["tau_n"], [-2, -2, 0], atol=1e-14)
@@ -206,8 +212,15 @@ def test_bad_inputs_raise_value_error():
     g_n, g_t, gtp = np.array([-1.0, 0.5]), np.array([0.1, 0.2]), np.zeros(2)
     rm = _cpp.return_mapping
     rm(g_n, g_t, gtp, 1.0, 1.0, 0.5)
-    for eps_n, eps_t, mu in [(0, 1, 0.5), (-1, 1, 0.5), (np.nan, 1, 0.5), (1, 0, 0.5),
-                             (1, np.inf, 0.5), (1, 1, -0.1), (1, 1, np.nan)]:
+    for eps_n, eps_t, mu in [
+        (0, 1, 0.5),
+        (-1, 1, 0.5),
+        (np.nan, 1, 0.5),
+        (1, 0, 0.5),
+        (1, np.inf, 0.5),
+        (1, 1, -0.1),
+        (1, 1, np.nan),
+    ]:
         with pytest.raises(ValueError):
             rm(g_n, g_t, gtp, eps_n, eps_t, mu)
     with pytest.raises(ValueError):

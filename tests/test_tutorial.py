@@ -29,9 +29,14 @@ def test_toml_block_runs(tmp_path):
     scene = tmp_path / "grain.toml"
     scene.write_text(toml)
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    r = subprocess.run([sys.executable, "-m", "dolfinx_forms", "run", str(scene), "--out",
-                        str(tmp_path / "out")], capture_output=True, text=True, env=env,
-                       cwd=tmp_path, timeout=600)
+    r = subprocess.run(
+        [sys.executable, "-m", "dolfinx_forms", "run", str(scene), "--out", str(tmp_path / "out")],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+        timeout=600,
+    )
     assert r.returncode == 0, r.stderr[-2000:]
     assert (tmp_path / "out" / "metrics.json").exists()
 
@@ -41,8 +46,20 @@ def test_user_scene_from_the_tutorial(tmp_path):
     between two stiff blocks, two contact pairs; its checks (Johnson's line load within 3 %,
     both zones carry it, symmetry, Hertz half-width within 10 %) must pass."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    r = subprocess.run([sys.executable, "-m", "dolfinx_forms", "run",
-                        str(ROOT / "demos" / "scenes" / "disc_squeeze.toml"), "--out",
-                        str(tmp_path / "out")], capture_output=True, text=True, env=env,
-                       cwd=tmp_path, timeout=900)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "dolfinx_forms",
+            "run",
+            str(ROOT / "demos" / "scenes" / "disc_squeeze.toml"),
+            "--out",
+            str(tmp_path / "out"),
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+        timeout=900,
+    )
     assert r.returncode == 0, r.stderr[-2000:]
