@@ -24,13 +24,8 @@ from petsc4py import PETSc
 from .boundary import BodyForce, Dirichlet, Load, Traction, dirichlet_dofs  # noqa: F401
 from .bulk import BulkForms
 from .contact_set import STATE_NAMES, ContactSet  # noqa: F401
-from .laws import as_law, lame
+from .laws import as_law
 from .newton import ContactSolverError, NewtonOptions, StepLog, load_steps  # noqa: F401
-
-
-def plane_strain(E, nu):
-    """Lame parameters (mu, lambda) of plane strain."""
-    return lame(E, nu)
 
 
 class ContactProblem:
