@@ -29,7 +29,6 @@ from typing import TYPE_CHECKING
 
 import dolfinx
 import dolfinx.cpp
-import dolfinx.io.gmshio
 import dolfinx.mesh
 import numpy as np
 
@@ -329,6 +328,8 @@ def extract_gmsh(gmsh):
     cells = lut[nodes[0].astype(np.int64)].reshape(-1, nv)
     used, cells = np.unique(cells, return_inverse=True)  # drop nodes used by no cell
     cells = cells.reshape(-1, nv)
+    import dolfinx.io.gmshio  # imports gmsh (0.3 s): only where gmsh meshes are converted
+
     perm = dolfinx.io.gmshio.cell_perm_array(dolfinx.mesh.to_type(name), nv)
     x = coords.reshape(-1, 3)[used, :2]
     return gtype, np.ascontiguousarray(x), np.ascontiguousarray(cells[:, perm]).astype(np.int64)
@@ -395,6 +396,8 @@ def scene_from_gmsh(
     cell_name, nv = _GMSH_CELLS[gtype]
     if comm.rank != 0:
         x, cells = np.zeros((0, 2)), np.zeros((0, nv), np.int64)
+
+    import dolfinx.io.gmshio
 
     domain = dolfinx.io.gmshio.ufl_mesh(gtype, 2)
     kwargs = partitioner_kwargs(comm, x, cells, cell_name, contact_box, bodies, pairs, h_contact)
