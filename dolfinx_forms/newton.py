@@ -21,7 +21,8 @@ class ContactSolverError(RuntimeError):
 @dataclass
 class NewtonOptions:
     rtol: float = 1e-10  # residual relative to the first residual of the step
-    atol: float = 1e-12  # absolute residual floor (force units)
+    ftol: float = 1e-13  # round-off floor, relative to the force scale (internal, external)
+    atol: float = 0.0  # absolute residual floor (force units); 0: none, the test is scale-free
     stol: float = 1e-12  # increment relative to |u|
     max_iterations: int = 25
     max_cutbacks: int = 6
@@ -58,12 +59,20 @@ def newton(problem, lam):
                 ),
             )
         if r0 is None:
-            r0 = max(r, opts.atol)
-        if r <= max(opts.rtol * r0, opts.atol):
+            r0 = r
+        # relative to the step's first residual, with a round-off floor relative to the
+        # problem's force scale: no absolute floor that would accept the initial guess of a
+        # problem with small forces (E = 1e-12 converges like E = 1)
+        if r <= max(opts.rtol * r0, opts.ftol * problem.force_scale, opts.atol):
             return True, residuals, ""
         if it > 0:
             dnorm, unorm = problem.du.vector.norm(), problem.u.vector.norm()
             if dnorm <= opts.stol * max(unorm, 1e-300) and r <= np.sqrt(opts.rtol) * r0:
+                return True, residuals, ""
+            # stalled at round-off (e.g. the cancelling terms of a finite-strain stress at small
+            # strain): no decrease, already within 1e3 rtol of the target, negligible update
+            stalled = it >= 2 and r > 0.5 * residuals[-2]
+            if stalled and r <= 1e3 * opts.rtol * r0 and dnorm <= 1e-8 * max(unorm, 1e-300):
                 return True, residuals, ""
         # An active set seen before without a lower residual: Newton is cycling. The
         # states live on the contact rank only: the decision must be collective.

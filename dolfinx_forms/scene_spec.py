@@ -20,7 +20,7 @@ tan, exp, log, abs):
       both:   contact_box [the pairs' overlaps] (cells owned by MPI rank 0)
   [solver]  eps0 [1.0], band [2 h], mu [0.0], ghost_penalty [0.01], grid_refine [4],
       num_gauss [2], steps [1], quadrature_degree, cut_degree [4], petsc {KEY = VALUE},
-      newton {rtol, atol, stol, max_iterations, max_cutbacks}
+      newton {rtol, ftol, atol, stol, max_iterations, max_cutbacks}
   [[bodies]]  name, shape = {type = "circle", centre, radius} | {type = "ellipse", centre,
       axes = [a, b], angle [0, degrees]} | {type = "box", min, max} | {type = "polygon",
       points | file (x, y per line)} | {type = "half_plane", point, normal (outward)},
@@ -303,7 +303,9 @@ def _solver(t):
             raise SpecError(petsc.path(k), f"must be a string or a number, got {v!r}")
         s["petsc"][k] = str(v).lower() if isinstance(v, bool) else str(v)
     newton = t.table("newton", {})
-    s["newton"] = {k: newton.number(k, None, lo=0, lo_open=True) for k in ("rtol", "atol", "stol")}
+    s["newton"] = {
+        k: newton.number(k, None, lo=0, lo_open=True) for k in ("rtol", "ftol", "atol", "stol")
+    }
     s["newton"].update(
         {
             k: newton.integer(k, None, lo=lo)

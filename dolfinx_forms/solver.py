@@ -206,6 +206,10 @@ class ContactProblem:
             self._rc.x.scatter_reverse(la.ScatterMode.add)
         with self.phase("assembly"):
             self.R.array[:] += self._rc.x.array[: self.n_owned]
+            # force scale of the round-off floor: internal forces (R + f) and external ones
+            self.R.copy(self.Ku)
+            self.Ku.axpy(1.0, self.f)
+            self.force_scale = max(self.Ku.norm(), self.f.norm())
             if with_tangent:
                 self.J.assemble()
                 self.J.zeroRows(self.bc_global, diag=1.0)
