@@ -170,7 +170,39 @@ def petsc_options(parser, items):
         if not sep or not key:
             parser.error(f"--petsc: expected KEY=VALUE, got {item!r}")
         opts[key] = value
+    keys = list(opts)
+    for n in range(1, len(keys) + 1):  # the first option PETSc refuses, with those before it
+        ierr = petsc_refuses({k: opts[k] for k in keys[:n]})
+        if ierr is not None:
+            k = keys[n - 1]
+            parser.error(
+                f"--petsc: PETSc refuses {k}={opts[k]} (error {ierr}: an unknown type "
+                "or a value of the wrong kind)"
+            )
     return opts
+
+
+def petsc_refuses(opts):
+    """PETSc's error code when a KSP/PC reads `opts` (set with a scratch prefix on
+    COMM_SELF, then removed), None when it accepts them. Nothing is printed."""
+    from petsc4py import PETSc
+
+    o, prefix = PETSc.Options(), "ils_check_"
+    for k, v in opts.items():
+        o[prefix + k] = v
+    ksp = PETSc.KSP().create(PETSc.COMM_SELF)
+    ksp.setOptionsPrefix(prefix)
+    PETSc.Sys.pushErrorHandler("ignore")
+    try:
+        ksp.setFromOptions()
+        return None
+    except PETSc.Error as e:
+        return e.ierr
+    finally:
+        PETSc.Sys.popErrorHandler()
+        for k in opts:
+            o.delValue(prefix + k)
+        ksp.destroy()
 
 
 def demo_parser(prog, doc, out, options=(), discretization=True, petsc=True, cells=None):
