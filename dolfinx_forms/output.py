@@ -72,25 +72,11 @@ def write_fields(folder, problem, name="solution"):
 
 def plot_tractions(path, pts, analytic=None, title="", xlabel="x (mm)", ylabel="traction (MPa)"):
     """Computed p_n, p_t at the contact points against analytic curves {label: (x, y)}."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 4))
-    ax.plot(pts["x"], pts["p_n"], ".", ms=3, label="p_n computed")
+    lines = {"p_n computed": (pts["x"], pts["p_n"], ".")}
     if np.any(pts["p_t"] != 0):
-        ax.plot(pts["x"], pts["p_t"], ".", ms=3, label="p_t computed")
-    for label, (x, y) in (analytic or {}).items():
-        ax.plot(x, y, "-", lw=1, label=label)
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.set_title(title)
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+        lines["p_t computed"] = (pts["x"], pts["p_t"], ".")
+    lines.update({label: (x, y, "-") for label, (x, y) in (analytic or {}).items()})
+    plot_lines(path, lines, title, xlabel, ylabel)
 
 
 def plot_lines(path, lines, title="", xlabel="x (mm)", ylabel="", vlines=()):

@@ -17,9 +17,9 @@ E, NU = 1000.0, 0.3
 W, H, A = 2.0, 1.0, 0.25  # block [-W/2, W/2] x [0, H], punch half-width A
 
 
-def block_scene(n=16, cell=dmesh.CellType.triangle):
+def block_scene(n=16, cell=dmesh.CellType.triangle, comm=MPI.COMM_WORLD):
     """One body, no contact pair: the block with its bottom, the punch and the top outside it."""
-    m = dmesh.create_rectangle(MPI.COMM_WORLD, [[-W / 2, 0], [W / 2, H]], [2 * n, n], cell)
+    m = dmesh.create_rectangle(comm, [[-W / 2, 0], [W / 2, H]], [2 * n, n], cell)
     ncells = m.topology.index_map(2).size_local + m.topology.index_map(2).num_ghosts
     values = np.ones(ncells, np.int32)
     body = Body("block", 1, Box([-W / 2, 0], [W / 2, H]), np.array([[-W / 2, 0], [W / 2, H]]))
@@ -113,7 +113,7 @@ def test_neo_hookean_punch_large_load_quadratic_newton():
     assert abs(p.reaction("punch")[1] - lin) > 1e-3 * abs(lin)
 
 
-def cut_block_scene():
+def cut_block_scene(comm=MPI.COMM_WORLD, h=1 / 16):
     """The block on a cut grid, its bottom cut by the slanted line y = 0.1 + 0.1 x (cut cells
     all along it), clamped on its left and right sides, the punch on the top."""
     from meshes.from_spec import build_scene
@@ -123,7 +123,7 @@ def cut_block_scene():
     spec = scene_spec.load(
         {
             "name": "cut_punch",
-            "discretization": {"kind": "cut", "h": 1 / 16, "extent": [[-W / 2, 0.0], [W / 2, H]]},
+            "discretization": {"kind": "cut", "h": h, "extent": [[-W / 2, 0.0], [W / 2, H]]},
             "bodies": [
                 {
                     "name": "block",
@@ -141,7 +141,7 @@ def cut_block_scene():
             ],
         }
     )
-    return build_scene(MPI.COMM_WORLD, spec)
+    return build_scene(comm, spec)
 
 
 def cut_punch(scene, law, depth):
