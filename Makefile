@@ -11,7 +11,7 @@ JOBS    ?= 2
 APT_PACKAGES := cmake make gcc g++ python3-sympy python3-dolfinx libdolfinx-dev python3-gmsh gmsh \
 	libeigen3-dev python3-mpi4py python3-meshio pybind11-dev python3-pytest \
 	python3-scipy python3-matplotlib libgtest-dev libbenchmark-dev python3-setuptools \
-	python3-venv openmpi-bin
+	python3-venv openmpi-bin libnanoflann-dev
 export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1

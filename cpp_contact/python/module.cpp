@@ -9,6 +9,8 @@ void bind_contact(py::module_& m);
 void bind_assembly(py::module_& m);
 void bind_location(py::module_& m);
 void bind_cut(py::module_& m);
+void bind_mls(py::module_& m);
+void bind_evolution(py::module_& m);
 
 PYBIND11_MODULE(_cpp, m) {
   m.doc() = "ILS contact core: level sets, closest points, contact surface, return mapping";
@@ -17,4 +19,6 @@ PYBIND11_MODULE(_cpp, m) {
   bind_assembly(m);
   bind_location(m);
   bind_cut(m);
+  bind_mls(m);
+  bind_evolution(m);
 }

@@ -1,0 +1,2 @@
+// Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
+#include "mls.h"
