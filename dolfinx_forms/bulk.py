@@ -44,11 +44,13 @@ class BulkForms:
         du, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
         p = self.V.ufl_element().degree()
 
-        def measure(tag=None, nonlinear=False):
+        def measure(tag=None, nonlinear=False, degree=None):
             if integration is not None:
-                return integration.measure(tag)
+                return integration.measure(tag, degree)
             md = {}
-            if quadrature_degree is not None:
+            if degree is not None:
+                md = {"quadrature_degree": int(degree)}
+            elif quadrature_degree is not None:
                 md = {"quadrature_degree": int(quadrature_degree)}
             elif nonlinear:
                 md = {"quadrature_degree": 2 * p}

@@ -24,6 +24,7 @@ import basix
 import numpy as np
 
 from . import _cpp
+from .obstacles import RigidObstacle
 
 
 @dataclass
@@ -41,12 +42,17 @@ class PairGeometry:
     quadrature: object  # _cpp.ContactQuadrature
     grid_spacing: float
     search_box: np.ndarray  # (2, 2)
+    obstacle: object = None  # obstacles.RigidObstacle on side j (no dofs), or None
+
+
+def _bbox(body):
+    return body.current_bbox if isinstance(body, RigidObstacle) else body.bbox
 
 
 def search_box(body_i, body_j, band):
     """Overlap of the two bounding boxes inflated by `band`, or None if they are disjoint."""
-    lo = np.maximum(body_i.bbox[0], body_j.bbox[0]) - band
-    hi = np.minimum(body_i.bbox[1], body_j.bbox[1]) + band
+    lo = np.maximum(_bbox(body_i)[0], _bbox(body_j)[0]) - band
+    hi = np.minimum(_bbox(body_i)[1], _bbox(body_j)[1]) + band
     if np.any(lo >= hi):
         return None
     return np.array([lo, hi])
@@ -61,7 +67,9 @@ def has_exact_shape(body):
 def body_levelset(grid, body):
     """The body's level set on `grid`: its exact shape sampled at the nodes, or, for a body given
     by a grid level set, that level set's C1 interpolant evaluated at the nodes (ValueError if
-    its grid does not cover `grid`)."""
+    its grid does not cover `grid`). A rigid obstacle gives its level set in its current pose."""
+    if isinstance(body, RigidObstacle):
+        return body.levelset(grid)
     if has_exact_shape(body):
         return _cpp.levelset_from_shape(grid, body.shape)
     if not isinstance(body.shape, _cpp.LevelSet):
@@ -84,6 +92,8 @@ def closest_points(body, phi, points, length_scale, exact=True):
     `_cpp.closest_point_projection`. With `exact` and an analytic shape: exact closest points
     on the shape (corners included); otherwise the iteration of eq 25 on the grid level set
     `phi` (the body's level set on the pair grid, `body_levelset`)."""
+    if isinstance(body, RigidObstacle):
+        return body.closest_points(points, length_scale, phi)
     if exact and has_exact_shape(body):
         return _cpp.closest_point_projection(body.shape, points, length_scale)
     return _cpp.closest_point_projection(phi, points)
@@ -182,9 +192,19 @@ class GridLocator:
 
 
 def pair_geometry(
-    V, scene, pair, band, *, grid_refine=4, num_gauss=2, max_outside=None, projection="auto"
+    V,
+    scene,
+    pair,
+    band,
+    *,
+    grid_refine=4,
+    num_gauss=2,
+    max_outside=None,
+    projection="auto",
+    obstacle=None,
 ):
-    """Contact quadrature of `pair` (indices into scene.bodies).
+    """Contact quadrature of `pair` (indices into scene.bodies), or of body pair[0] and the
+    rigid `obstacle` (pair[1] ignored): side j then has no dofs (nodes_j = 0).
 
     band: largest initial gap covered by Gamma_c (eq 22 uses eps = band / 2), a length.
     grid_refine: level-set grid cells per mesh size h_contact.
@@ -195,7 +215,8 @@ def pair_geometry(
     if projection not in ("auto", "levelset"):
         raise ValueError(f"projection must be 'auto' or 'levelset', got {projection!r}")
     i, j = pair
-    bi, bj = scene.bodies[i], scene.bodies[j]
+    bi = scene.bodies[i]
+    bj = scene.bodies[j] if obstacle is None else obstacle
     h = scene.h_contact
     dx = h / grid_refine
     box = search_box(bi, bj, band + 4 * dx)
@@ -238,6 +259,9 @@ def pair_geometry(
     sides = []
     cut = getattr(scene, "cut", None)
     for body, p in ((bi, p_i), (bj, p_j)):
+        if body is obstacle:  # rigid side: no dofs, its motion is prescribed (u_j_prescribed)
+            sides.append((np.zeros((len(p), 0), np.int32), np.zeros((len(p), 0))))
+            continue
         if cut is not None:  # structured grid: O(1) location by index
             loc = GridLocator(scene.mesh, scene.cell_tags, body.tag, cut, degree)
         else:
@@ -254,5 +278,5 @@ def pair_geometry(
         s["weights"], normals, tangents, g_n0, sides[0][0], sides[1][0], sides[0][1], sides[1][1]
     )
     return PairGeometry(
-        pair, s["points"], s["weights"], normals, tangents, p_i, p_j, g_n0, q, dx, box
+        pair, s["points"], s["weights"], normals, tangents, p_i, p_j, g_n0, q, dx, box, obstacle
     )

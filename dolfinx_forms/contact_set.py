@@ -12,6 +12,7 @@ import numpy as np
 
 from . import _cpp
 from .contact import pair_geometry
+from .obstacles import contact_resultants
 
 STATE_NAMES = {0: "open", 1: "stick", 2: "slip"}
 _NONE = np.zeros(0)
@@ -19,18 +20,29 @@ _NONE = np.zeros(0)
 
 class ContactSet:
     """Contact points of `scene.pairs` on rank `rank` (empty elsewhere), penalty eps_n, eps_t
-    (eq 51) and friction coefficient mu (0: frictionless, no history)."""
+    (eq 51) and friction coefficient mu (0: frictionless, no history). obstacles:
+    `obstacles.RigidObstacle`s, each paired with every body it may touch (its `bodies`); their
+    prescribed motion at load level lam is set by `set_load`."""
 
-    def __init__(self, V, scene, eps_n, eps_t, mu, band, grid_refine=4, num_gauss=2, rank=0):
+    def __init__(
+        self, V, scene, eps_n, eps_t, mu, band, grid_refine=4, num_gauss=2, rank=0, obstacles=()
+    ):
         self.eps_n, self.eps_t, self.mu = float(eps_n), float(eps_t), float(mu)
         self.pairs = []
+        self.obstacles = list(obstacles)
         if V.mesh.comm.rank == rank:
-            for pair in scene.pairs:
-                g = pair_geometry(
-                    V, scene, pair, band, grid_refine=grid_refine, num_gauss=num_gauss
-                )
+            kw = dict(grid_refine=grid_refine, num_gauss=num_gauss)
+            candidates = [(pair, None) for pair in scene.pairs] + [
+                ((i, -1), ob)
+                for ob in self.obstacles
+                for i, b in enumerate(scene.bodies)
+                if ob.bodies is None or b.tag in np.atleast_1d(ob.bodies)
+            ]
+            for pair, ob in candidates:
+                g = pair_geometry(V, scene, pair, band, obstacle=ob, **kw)
                 if g is not None:
                     self.pairs.append(g)
+        self._lam = None
         self.history = [_cpp.FrictionHistory(len(g.weights), 1) for g in self.pairs]
         self.slip_start = [np.zeros(len(g.weights)) for g in self.pairs]
         self.last = [None] * len(self.pairs)  # kernel output of the last evaluation
@@ -46,6 +58,41 @@ class ContactSet:
     def add_zeros(self, A):
         for g in self.pairs:
             _cpp.add_coupling_zeros(A, g.quadrature)
+
+    def names(self, scene):
+        """(body i, body j or obstacle) names of each pair: the key of a pair across scenes."""
+        return [
+            (
+                scene.bodies[g.pair[0]].name,
+                g.obstacle.name if g.obstacle is not None else scene.bodies[g.pair[1]].name,
+            )
+            for g in self.pairs
+        ]
+
+    def set_load(self, lam):
+        """Prescribed displacement of the obstacles at the closest points for the fraction lam
+        of their step motion (u_j_prescribed of the kernel, eq 26)."""
+        if lam == self._lam:
+            return
+        for g in self.pairs:
+            if g.obstacle is not None:
+                g.quadrature.u_j_prescribed = g.obstacle.step_displacement(g.p_j, lam)
+        self._lam = lam
+
+    def obstacle_resultants(self):
+        """{obstacle name: (force (2,), moment)} exerted by the bodies on each obstacle in the
+        last accepted state (see `obstacles.contact_resultants`); zeros without contact."""
+        out = {ob.name: (np.zeros(2), 0.0) for ob in self.obstacles}
+        for k, g in enumerate(self.pairs):
+            s = self.committed[k]
+            if g.obstacle is None or s is None:
+                continue
+            F, M = contact_resultants(
+                g.obstacle, g.points, g.weights, g.normals, g.tangents, s["tau_n"], s["tau_t"], g.p_j
+            )
+            F0, M0 = out[g.obstacle.name]
+            out[g.obstacle.name] = (F0 + F, M0 + M)
+        return out
 
     def _evaluate(self, k, u, b=None, A=None, fd=False, fd_step=1e-9, mu=None):
         mu = self.mu if mu is None else mu

@@ -78,6 +78,15 @@ def _mixed_form(ufl_form, replace, subdomains):
     return form, module
 
 
+def shape_values(shape, points):
+    """Values (n,) at points (n, 2) of a body's cut level set: a shape (callable, e.g. a
+    `_cpp.Shape`) or a grid `_cpp.LevelSet` (its C1 interpolant; node values at grid nodes)."""
+    points = np.ascontiguousarray(points, dtype=float)
+    if isinstance(shape, _cpp.LevelSet):
+        return shape.evaluate(points)[0]
+    return np.asarray(shape(points), float)
+
+
 def levelset_values(scene, V):
     """A Function on the scalar Q1 space V of scene.mesh holding at each dof the cut shape of the
     body owning it (the bodies are disjoint: every dof belongs to one body); ghosts updated."""
@@ -88,7 +97,7 @@ def levelset_values(scene, V):
     for tag, shape in scene.cut.levelsets.items():
         dofs = np.unique(cell_dofs[scene.cell_tags.values == tag])
         if len(dofs):
-            phi.x.array[dofs] = np.asarray(shape(np.ascontiguousarray(xdof[dofs])))
+            phi.x.array[dofs] = shape_values(shape, xdof[dofs])
     phi.x.scatter_forward()
     return phi
 
@@ -161,10 +170,14 @@ class CutIntegration:
         self.num_cut_cells = len(cells)
         self._keep = []
 
-    def measure(self, tags=None):
-        """The measure over the material of the bodies `tags` (a tag, a list, or None: all)."""
+    def measure(self, tags=None, degree=None):
+        """The measure over the material of the bodies `tags` (a tag, a list, or None: all).
+        degree: FFCx degree on interior cells (None: FFCx's estimate); `self.degree` puts the
+        cut cells' Gauss points on every cell, where a `Quadrature` coefficient of that degree
+        (e.g. the MPM's projected stress) lives."""
         bodies = sorted(set(self.scene.cell_tags.values)) if tags is None else np.atleast_1d(tags)
-        dx = ufl.Measure("dx", domain=self.mesh, subdomain_data=self.cell_ids)
+        md = {} if degree is None else {"quadrature_degree": int(degree)}
+        dx = ufl.Measure("dx", domain=self.mesh, subdomain_data=self.cell_ids, metadata=md)
         dxq = ufl.Measure(
             "dx",
             domain=self.mesh,

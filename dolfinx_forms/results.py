@@ -12,7 +12,7 @@ from pathlib import Path
 
 from .folders import MARKER, OutputFolderError, atomic_output_dir  # noqa: F401
 
-PHASES = ("total", "mesh", "assembly", "contact", "solve")
+PHASES = ("total", "mesh", "assembly", "contact", "solve", "mls", "points", "evolution")
 
 
 def new_metrics(benchmark, discretization, parameters):

@@ -37,7 +37,8 @@ class ContactProblem:
     initial gap that Gamma_c covers (a length); degree: Lagrange degree (1 or 2; 1 on a cut
     scene); loads: `BodyForce`/`Load`s; quadrature_degree: see `BulkForms`. A scene with `cut`
     data (meshes.cut) integrates over the inside part of cut cells (`cut.CutIntegration`,
-    degree `cut_degree`) with ghost penalty `ghost_penalty` (0: none).
+    degree `cut_degree`) with ghost penalty `ghost_penalty` (0: none). obstacles: rigid
+    `obstacles.RigidObstacle`s (no dofs) whose step motion is ramped with lam.
     """
 
     def __init__(
@@ -61,6 +62,7 @@ class ContactProblem:
         ghost_penalty=0.01,
         quadrature_degree=None,
         cut_degree=4,
+        obstacles=(),
         log=print,
     ):
         self.scene, self.mesh = scene, scene.mesh
@@ -121,6 +123,7 @@ class ContactProblem:
                 grid_refine,
                 num_gauss,
                 contact_rank,
+                obstacles,
             )
         self.pairs = self.contact.pairs
 
@@ -195,6 +198,7 @@ class ContactProblem:
                 self.K.copy(self.J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
             self.bulk.add_nonlinear(self.R, self.J if with_tangent else None)
         with self.phase("contact"):
+            self.contact.set_load(lam)
             self._rc.x.array[:] = 0.0
             self.contact.assemble(
                 self.u.x.array,

@@ -36,7 +36,7 @@ import dolfinx.fem
 import dolfinx.mesh
 import numpy as np
 import ufl
-from dolfinx_forms.cut import CUT, GHOST_FACET, INTERIOR, levelset_values  # noqa: F401
+from dolfinx_forms.cut import CUT, GHOST_FACET, INTERIOR, levelset_values, shape_values  # noqa: F401
 
 from .hertz import hertz_contact_box
 from .scene import Body, Scene, on_box_side, partitioner_kwargs, summary, tag_boundaries
@@ -167,7 +167,8 @@ class CutBody:
     name: str
     tag: int
     window: np.ndarray  # (2, 2) [[x0, y0], [x1, y1]], all four values grid lines
-    shape: object  # the cut level set (only its zero contour cuts cells), < 0 inside
+    shape: object  # the cut level set (a shape or a grid _cpp.LevelSet; only its zero contour
+    # cuts cells), < 0 inside
     bbox: np.ndarray | None = None  # (2, 2) bounding box of the body; None: from the grid
 
 
@@ -206,7 +207,7 @@ def _body_grid(xlines, ylines, body):
     X, Y = xlines[i0 : i1 + 1], ylines[j0 : j1 + 1]
     nx, ny = len(X) - 1, len(Y) - 1
     pts = np.stack(np.meshgrid(X, Y), axis=-1).reshape(-1, 2)  # vertex (i, j) is j (nx+1) + i
-    phi = np.asarray(body.shape(pts), float)
+    phi = shape_values(body.shape, pts)
     v = (np.arange(ny)[:, None] * (nx + 1) + np.arange(nx)[None, :]).ravel()
     quads = np.stack([v, v + 1, v + nx + 1, v + nx + 2], axis=1)
     pc = phi[quads]
@@ -315,8 +316,16 @@ def cut_scene(
     kind_tags = dolfinx.mesh.meshtags(mesh, tdim, local, ckinds)
     kind_tags.name = "kinds"
     windows = {b.tag: np.asarray(b.window, float) for b in bodies}
+    # a grid level set (an evolved body) is its own contact shape: its window only limits cells
     scene_bodies = [
-        Body(b.name, b.tag, df.Intersection([b.shape, df.Box(*windows[b.tag])]), bbox)
+        Body(
+            b.name,
+            b.tag,
+            b.shape
+            if isinstance(b.shape, df.LevelSet)
+            else df.Intersection([b.shape, df.Box(*windows[b.tag])]),
+            bbox,
+        )
         for b, bbox in zip(bodies, bboxes)
     ]
     facet_tags, boundaries = tag_boundaries(mesh, cvalues, scene_bodies, boundary_markers)

@@ -55,8 +55,8 @@ void point_law(const CoulombPenalty& law, double g_n, double g_t, double gtp_old
 
 //-----------------------------------------------------------------------------
 void ContactQuadrature::validate() const {
-  if (nodes_i <= 0 or nodes_j <= 0)
-    throw std::invalid_argument("ContactQuadrature: nodes_i and nodes_j must be > 0");
+  if (nodes_i <= 0 or nodes_j < 0)
+    throw std::invalid_argument("ContactQuadrature: need nodes_i > 0 and nodes_j >= 0");
   const std::size_t nq = weights.size();
   check(normals.size(), 2 * nq, "normals");
   check(tangents.size(), 2 * nq, "tangents");
@@ -65,6 +65,8 @@ void ContactQuadrature::validate() const {
   check(dofs_j.size(), nq * nodes_j, "dofs_j");
   check(basis_i.size(), nq * nodes_i, "basis_i");
   check(basis_j.size(), nq * nodes_j, "basis_j");
+  if (!u_j_prescribed.empty())
+    check(u_j_prescribed.size(), 2 * nq, "u_j_prescribed");
 }
 
 //-----------------------------------------------------------------------------
@@ -123,6 +125,9 @@ ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPena
     for (std::size_t a = 0; a < nd; ++a)
       for (std::size_t c = 0; c < 2; ++c)
         du[c] += N[a] * u[2 * std::size_t(dofs[a]) + c];
+    if (!q.u_j_prescribed.empty())
+      for (std::size_t c = 0; c < 2; ++c)
+        du[c] += q.u_j_prescribed[2 * p + c];
     const PointGaps gaps = point_gaps(q.g_n0[p], du, std::span<const double, 2>(n, 2),
                                       std::span<const double, 2>(t, 2));
     const double gtp0 = friction ? gtp_old[p] : 0.0;

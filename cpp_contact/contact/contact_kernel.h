@@ -16,9 +16,11 @@ namespace contact {
 /// that contains the closest point P_i (P_j) with the basis values there. Small strain: the
 /// geometry does not change during Newton, only u does (eqs 27-30).
 /// Dof indices are *block* (node) indices into a local vector with block size 2.
+/// Side j may have no dofs (nodes_j = 0): a rigid obstacle, whose prescribed displacement at
+/// P_j enters the jump through `u_j_prescribed` (seed 002: rigid level-set objects).
 struct ContactQuadrature {
-  int nodes_i = 0;                  ///< basis functions per cell of body i
-  int nodes_j = 0;                  ///< basis functions per cell of body j
+  int nodes_i = 0;                  ///< basis functions per cell of body i (> 0)
+  int nodes_j = 0;                  ///< basis functions per cell of body j (0: rigid side)
   std::vector<double> weights;      ///< (nq,) length measure
   std::vector<double> normals;      ///< (nq, 2)
   std::vector<double> tangents;     ///< (nq, 2)
@@ -27,6 +29,9 @@ struct ContactQuadrature {
   std::vector<std::int32_t> dofs_j; ///< (nq, nodes_j)
   std::vector<double> basis_i;      ///< (nq, nodes_i) basis values at P_i
   std::vector<double> basis_j;      ///< (nq, nodes_j)
+  /// (nq, 2) displacement of side j at P_j not carried by dofs (a rigid obstacle's prescribed
+  /// motion), added to u_j(P_j) in the jump of eq 26; empty: none
+  std::vector<double> u_j_prescribed;
 
   /// @brief Number of quadrature points.
   std::size_t size() const { return weights.size(); }
@@ -55,6 +60,7 @@ enum class TangentMode { exact, finite_difference };
 /// @brief Contact residual and tangent of eq 48 for a body pair.
 ///
 /// At each point: g_n = g_n0 + (u_j(P_j) - u_i(P_i)).n, g_t = (u_j - u_i).t (`point_gaps`,
+/// u_j(P_j) including q.u_j_prescribed;
 /// gaps.h, with u interpolated at P_i and P_j by the basis values), the return
 /// mapping (Algorithm 1) gives tau_n, tau_t and D = d[tau_n, tau_t]/d[g_n, g_t], and with
 /// B = [n t]^T [-N_i, N_j] (2 x 2nd):  r += w B^T [tau_n, tau_t],  K += w B^T D B.

@@ -1,2 +1,264 @@
 // Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
 #include "mls.h"
+
+#include <nanoflann.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace contact {
+
+double quadratic_spline_weight(double r) {
+  r = std::abs(r);
+  if (r <= 0.5)
+    return 0.75 - r * r;
+  if (r < 1.5) {
+    const double s = 1.5 - r;
+    return 0.5 * s * s;
+  }
+  return 0.0;
+}
+
+namespace {
+
+/// nanoflann dataset adaptor over the projector's own copy of the sources.
+struct Cloud {
+  std::vector<double> x;
+  std::size_t dim;
+  std::size_t kdtree_get_point_count() const { return x.size() / dim; }
+  double kdtree_get_pt(std::uint32_t i, std::size_t k) const { return x[i * dim + k]; }
+  template <class BBox> bool kdtree_get_bbox(BBox&) const { return false; }
+};
+
+// Fixed-dimension trees: the distance loops unroll (the dimension is known per projector).
+template <int D>
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud,
+                                                 D, std::uint32_t>;
+
+/// Reciprocal 1-norm condition number of the SPD moment matrix M (N x N) and its first inverse
+/// column c = M^{-1} e_0 (the only one eq 44 needs, since P(x_t) = e_0 on the centred basis).
+/// Exact 1-norm of M^{-1} (N <= 4 solves are cheaper than an estimator); 0 if the Cholesky
+/// factorisation breaks down (M singular or indefinite by round-off).
+template <int N> double invert_first_column(std::array<double, N * N> M, std::array<double, N>& c) {
+  double norm = 0;
+  for (int j = 0; j < N; ++j) {
+    double s = 0;
+    for (int i = 0; i < N; ++i)
+      s += std::abs(M[i * N + j]);
+    norm = std::max(norm, s);
+  }
+  // In-place Cholesky M = L L^T (lower triangle).
+  for (int j = 0; j < N; ++j) {
+    double d = M[j * N + j];
+    for (int k = 0; k < j; ++k)
+      d -= M[j * N + k] * M[j * N + k];
+    if (!(d > 0))
+      return 0.0;
+    d = std::sqrt(d);
+    M[j * N + j] = d;
+    for (int i = j + 1; i < N; ++i) {
+      double s = M[i * N + j];
+      for (int k = 0; k < j; ++k)
+        s -= M[i * N + k] * M[j * N + k];
+      M[i * N + j] = s / d;
+    }
+  }
+  double inv_norm = 0;
+  for (int col = 0; col < N; ++col) {
+    std::array<double, N> y{};
+    for (int i = 0; i < N; ++i) { // L y = e_col
+      double s = (i == col) ? 1.0 : 0.0;
+      for (int k = 0; k < i; ++k)
+        s -= M[i * N + k] * y[k];
+      y[i] = s / M[i * N + i];
+    }
+    for (int i = N - 1; i >= 0; --i) { // L^T x = y
+      double s = y[i];
+      for (int k = i + 1; k < N; ++k)
+        s -= M[k * N + i] * y[k];
+      y[i] = s / M[i * N + i];
+    }
+    double s = 0;
+    for (int i = 0; i < N; ++i)
+      s += std::abs(y[i]);
+    inv_norm = std::max(inv_norm, s);
+    if (col == 0)
+      c = y;
+  }
+  const double rc = 1.0 / (norm * inv_norm);
+  return std::isfinite(rc) ? rc : 0.0;
+}
+
+bool all_finite(std::span<const double> a) {
+  for (double v : a)
+    if (!std::isfinite(v))
+      return false;
+  return true;
+}
+
+} // namespace
+
+struct MLSProjector::Impl {
+  Cloud cloud;
+  std::unique_ptr<Tree<2>> tree2;
+  std::unique_ptr<Tree<3>> tree3;
+
+  template <int D> const Tree<D>& tree() const {
+    if constexpr (D == 2)
+      return *tree2;
+    else
+      return *tree3;
+  }
+
+  template <int D>
+  void project(double h, const MLSOptions& opt, std::span<const double> values, std::size_t m,
+               std::span<const double> targets, MLSResult& out) const;
+};
+
+template <int D>
+void MLSProjector::Impl::project(double h, const MLSOptions& opt, std::span<const double> values,
+                                 std::size_t m, std::span<const double> targets,
+                                 MLSResult& out) const {
+  constexpr int N = D + 1;
+  const std::size_t k = targets.size() / D;
+  const Tree<D>& index = tree<D>();
+  const nanoflann::SearchParams unsorted(32, 0.0f, false);
+  // Buffers reused over all targets: the radius search result and the weights of its hits.
+  std::vector<std::pair<std::uint32_t, double>> hits;
+  std::vector<double> w;
+  hits.reserve(256);
+  w.reserve(256);
+
+  for (std::size_t t = 0; t < k; ++t) {
+    const double* xt = targets.data() + D * t;
+    double widen = 1.0;
+    for (int level = 0;; ++level, widen *= opt.widen_factor) {
+      const double H = h * widen;
+      index.radiusSearch(xt, 2.25 * H * H, hits, unsorted); // squared radius (1.5 H)^2
+      // Moment matrix (eq 42) on the basis P = [1, (x - x_t)/H] centred at the target.
+      std::array<double, N * N> M{};
+      w.resize(hits.size());
+      std::int32_t count = 0;
+      for (std::size_t q = 0; q < hits.size(); ++q) {
+        w[q] = quadratic_spline_weight(std::sqrt(hits[q].second) / H);
+        if (!(w[q] > 0))
+          continue;
+        ++count;
+        const double* xp = cloud.x.data() + D * std::size_t(hits[q].first);
+        std::array<double, N> P;
+        P[0] = 1.0;
+        for (int a = 0; a < D; ++a)
+          P[a + 1] = (xp[a] - xt[a]) / H;
+        for (int i = 0; i < N; ++i)
+          for (int j = 0; j <= i; ++j)
+            M[i * N + j] += w[q] * P[i] * P[j];
+      }
+      for (int i = 0; i < N; ++i)
+        for (int j = i + 1; j < N; ++j)
+          M[i * N + j] = M[j * N + i];
+
+      std::array<double, N> c{};
+      const double rc = count >= N ? invert_first_column<N>(M, c) : 0.0;
+      if (rc >= opt.rcond_min) {
+        // Eq 44 at x = x_t: u^h = e_0^T M^{-1} b = sum_p w_p (P_p . c) u_p, for all m fields.
+        double* u = out.values.data() + m * t;
+        for (std::size_t q = 0; q < hits.size(); ++q) {
+          if (!(w[q] > 0))
+            continue;
+          const double* xp = cloud.x.data() + D * std::size_t(hits[q].first);
+          double phi = c[0];
+          for (int a = 0; a < D; ++a)
+            phi += c[a + 1] * (xp[a] - xt[a]) / H;
+          phi *= w[q];
+          const double* up = values.data() + m * std::size_t(hits[q].first);
+          for (std::size_t f = 0; f < m; ++f)
+            u[f] += phi * up[f];
+        }
+        out.widening[t] = widen;
+        out.rcond[t] = rc;
+        out.neighbours[t] = count;
+        break;
+      }
+      if (level == opt.max_widenings) {
+        std::ostringstream msg;
+        msg << "MLSProjector::project: target " << t << " at (";
+        for (int a = 0; a < D; ++a)
+          msg << (a ? ", " : "") << xt[a];
+        msg << ") has a singular MLS fit (" << count << " neighbours, rcond " << rc
+            << ") even with the support widened to " << widen
+            << " h: the sources are too far or collinear there";
+        throw std::runtime_error(msg.str());
+      }
+    }
+  }
+}
+
+MLSProjector::MLSProjector(std::span<const double> sources, int dim, double h, MLSOptions options)
+    : _impl(std::make_unique<Impl>()), _dim(dim), _h(h), _options(options) {
+  if (dim != 2 and dim != 3)
+    throw std::invalid_argument("MLSProjector: dim must be 2 or 3, got " + std::to_string(dim));
+  if (sources.size() % std::size_t(dim) != 0)
+    throw std::invalid_argument("MLSProjector: sources must hold (n, dim) coordinates");
+  const std::size_t n = sources.size() / std::size_t(dim);
+  if (n < std::size_t(dim) + 1)
+    throw std::invalid_argument("MLSProjector: sources must hold at least dim + 1 points");
+  if (n > std::numeric_limits<std::uint32_t>::max())
+    throw std::invalid_argument("MLSProjector: sources has too many points for 32-bit indices");
+  if (!all_finite(sources))
+    throw std::invalid_argument("MLSProjector: sources has non-finite coordinates");
+  if (!(std::isfinite(h) and h > 0))
+    throw std::invalid_argument("MLSProjector: h must be finite and > 0");
+  if (!(options.rcond_min >= 0 and options.rcond_min < 1 and options.widen_factor > 1 and
+        std::isfinite(options.widen_factor) and options.max_widenings >= 0))
+    throw std::invalid_argument("MLSProjector: options need 0 <= rcond_min < 1, finite "
+                                "widen_factor > 1 and max_widenings >= 0");
+  _impl->cloud = Cloud{std::vector<double>(sources.begin(), sources.end()), std::size_t(dim)};
+  // Leaves of ~16 points: a support holds ~30-70 sources, so few leaves are visited.
+  const nanoflann::KDTreeSingleIndexAdaptorParams params(16);
+  if (dim == 2)
+    _impl->tree2 = std::make_unique<Tree<2>>(2, _impl->cloud, params);
+  else
+    _impl->tree3 = std::make_unique<Tree<3>>(3, _impl->cloud, params);
+}
+
+MLSProjector::~MLSProjector() = default;
+MLSProjector::MLSProjector(MLSProjector&&) noexcept = default;
+MLSProjector& MLSProjector::operator=(MLSProjector&&) noexcept = default;
+
+std::size_t MLSProjector::num_points() const {
+  return _impl->cloud.x.size() / std::size_t(_dim);
+}
+
+MLSResult MLSProjector::project(std::span<const double> values, std::size_t m,
+                                std::span<const double> targets) const {
+  const std::size_t n = num_points();
+  if (m < 1)
+    throw std::invalid_argument("MLSProjector::project: values must have m >= 1 fields (columns)");
+  if (values.size() != n * m)
+    throw std::invalid_argument("MLSProjector::project: values must hold (n, m) = (" +
+                                std::to_string(n) + ", " + std::to_string(m) + ") entries, got " +
+                                std::to_string(values.size()));
+  if (targets.size() % std::size_t(_dim) != 0)
+    throw std::invalid_argument("MLSProjector::project: targets must hold (k, dim) coordinates");
+  if (!all_finite(values))
+    throw std::invalid_argument("MLSProjector::project: values has non-finite entries");
+  if (!all_finite(targets))
+    throw std::invalid_argument("MLSProjector::project: targets has non-finite coordinates");
+
+  const std::size_t k = targets.size() / std::size_t(_dim);
+  MLSResult out{std::vector<double>(k * m, 0.0), std::vector<double>(k), std::vector<double>(k),
+                std::vector<std::int32_t>(k)};
+  if (_dim == 2)
+    _impl->project<2>(_h, _options, values, m, targets, out);
+  else
+    _impl->project<3>(_h, _options, values, m, targets, out);
+  return out;
+}
+
+} // namespace contact

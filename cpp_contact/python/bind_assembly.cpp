@@ -63,6 +63,20 @@ void bind_assembly(py::module_& m) {
                                return to_numpy(std::vector<double>(q.g_n0),
                                                {py::ssize_t(q.size())});
                              })
+      .def_property(
+          "u_j_prescribed",
+          [](const ContactQuadrature& q) {
+            return to_numpy(std::vector<double>(q.u_j_prescribed),
+                            {py::ssize_t(q.u_j_prescribed.size() / 2), 2});
+          },
+          [](ContactQuadrature& q, const carray& v) {
+            if (v.size() != 0 and (v.ndim() != 2 or v.shape(0) != py::ssize_t(q.size()) or
+                                   v.shape(1) != 2))
+              throw std::invalid_argument("u_j_prescribed: expected shape (nq, 2) or empty");
+            q.u_j_prescribed = copy_of(v);
+          },
+          "(nq, 2) displacement of side j at P_j not carried by dofs (rigid obstacle motion), "
+          "added to u_j(P_j) in the gaps; empty: none")
       .def(
           "coupling_dofs",
           [](const ContactQuadrature& q) {

@@ -1,0 +1,181 @@
+#!/usr/bin/python3
+"""Brazilian disc over many load steps: the implicit level-set MPM (paper 5.3.1).
+
+Physics. A disc of radius R (E, nu, plane strain) between two rigid platens, the lower fixed,
+the upper moved down by --step-displacement per step; Coulomb friction mu on both contacts. The
+disc is a level set on a uniform grid of spacing h carrying material points; every step rebuilds
+the cut cells from the evolved level set, projects the points' stress to the new integration
+points (MLS) and solves for the displacement increment (ImplicitMPM). By symmetry u_x = 0 on
+x = 0, which also removes the rigid modes of the free disc.
+
+The check. The contact half-width against Hertz for a cylinder on a rigid flat,
+a = 2 sqrt(F R (1 - nu^2) / (pi E)) (the paper's eq 52 is 4x too small), at every step with
+a > 5 h; the forces on the two platens equal (the disc is free: equilibrium); the level-set
+area against the material points' volume; the mass of the points constant.
+
+Run: /usr/bin/python3 demos/brazilian_disc.py [--steps 50] [--h 0.2]
+Results and discussion: docs/demos.md#brazilian-disc
+"""
+
+import sys
+
+import numpy as np
+
+from dolfinx_forms import cli
+from dolfinx_forms.boundary import Dirichlet
+from dolfinx_forms.mpm import ImplicitMPM, MPMBody
+from dolfinx_forms.mpm_output import run_steps
+from meshes.mpm import brazilian_disc
+
+# fmt: off
+OPTIONS = [  # option, kind, default[, help]
+    ("--R", "(0, inf)", 10.0, "disc radius (mm)"),
+    ("--E", "(0, inf)", 100e3, "Young's modulus (N/mm^2)"),
+    ("--nu", "(-1, 0.5)", 0.3),
+    ("--mu", "[0, inf)", 0.5),
+    ("--step-displacement", "(0, inf)", 0.02, "platen travel per step (mm)"),
+    ("--steps", range(1, 10001), 50),
+    ("--h", "(0, inf)", 0.2, "grid spacing (mm)"),
+    ("--eps0", "(0, inf)", 1.0),
+    ("--series-every", range(1, 10001), 10, "steps between frames of the time series"),
+]
+COLUMNS = ["step", "displacement", "force_top", "force_bottom", "half_width_top",
+           "half_width_bottom", "area_levelset", "volume_points", "newton_iterations", "wall_s"]
+# fmt: on
+
+
+def parse(argv):
+    p = cli.demo_parser("brazilian_disc.py", __doc__, "results/brazilian_disc", OPTIONS,
+                        discretization=False)
+    a = p.parse_args(argv)
+    if not a.h <= a.R / 5:
+        p.error(f"--h: must be in (0, R/5] = (0, {a.R / 5:g}] (at least 10 cells across), got {a.h}")
+    if not a.R / a.h <= 2000:
+        p.error(f"--h: must be >= R/2000 = {a.R / 2000:g} (grid of at most 4000^2 cells), got {a.h}")
+    if not a.steps * a.step_displacement <= 0.2 * a.R:
+        p.error(f"--step-displacement: steps x step must be <= 0.2 R = {0.2 * a.R:g} "
+                f"(small-strain MPM), got {a.steps * a.step_displacement:g}")
+    if not a.step_displacement <= 0.5 * a.h:
+        p.error(f"--step-displacement: must be <= h/2 = {0.5 * a.h:g} per step (contact band "
+                f"and level-set advection), got {a.step_displacement}")
+    return a
+
+
+def hertz_half_width(F, R, E, nu):
+    """Cylinder on a rigid flat (plane strain): a = 2 sqrt(F R (1 - nu^2) / (pi E))."""
+    return 2 * np.sqrt(np.maximum(F, 0) * R * (1 - nu**2) / (np.pi * E))
+
+
+def build(run):
+    p = run.params
+    grid, (name, tag, shape), platens, scene = brazilian_disc(
+        run.comm, p["R"], p["h"], p["step_displacement"], p["steps"]
+    )
+    symmetry = Dirichlet(lambda x: np.isclose(x[0], 0.0, atol=1e-9 * p["R"]), 0, 0.0)
+    return ImplicitMPM(
+        run.comm, grid, [MPMBody(name, tag, (p["E"], p["nu"]), shape)], scene,
+        obstacles=platens, dirichlet=[symmetry], mu=p["mu"], eps0=p["eps0"], timer=run.timer,
+    )
+
+
+def row(run, rec):
+    widths = {q["body_j"]: q["half_width"] for q in rec["pairs"]}
+    return dict(
+        step=rec["step"],
+        displacement=rec["step"] * run.params["step_displacement"],
+        force_top=rec["obstacles"]["platen_top"]["fy"],
+        force_bottom=-rec["obstacles"]["platen_bottom"]["fy"],
+        half_width_top=widths.get("platen_top", 0.0),
+        half_width_bottom=widths.get("platen_bottom", 0.0),
+        area_levelset=rec["area_levelset"]["disc"],
+        volume_points=rec["volume_points"]["disc"],
+        newton_iterations=rec["newton_iterations"],
+        wall_s=rec["wall_s"],
+    )
+
+
+def evaluate(run):
+    """Hertz half-width where a > 5 h, force balance, area vs point volume, mass."""
+    p, rows = run.params, run.rows
+    F = np.array([r["force_top"] for r in rows])
+    Fb = np.array([r["force_bottom"] for r in rows])
+    a = np.array([[r["half_width_top"], r["half_width_bottom"]] for r in rows])
+    a_h = hertz_half_width(F, p["R"], p["E"], p["nu"])
+    judged = a.min(axis=1) > 5 * p["h"]
+    err = np.abs(a / a_h[:, None] - 1)
+    balance = np.abs(F - Fb) / np.maximum(np.abs(F), 1e-300)
+    area = np.array([r["area_levelset"] for r in rows])
+    vol = np.array([r["volume_points"] for r in rows])
+    mass = [r["mass"]["disc"] for r in run.records]
+    run.results.update(
+        force_top=F.tolist(), force_bottom=Fb.tolist(), half_width=a.tolist(),
+        half_width_rel_error_max=float(err[judged].max()) if judged.any() else None,
+        steps_judged=int(judged.sum()),
+        force_balance_rel_max=float(balance.max()),
+        area_vs_points_rel_max=float(np.max(np.abs(area / vol - 1))),
+        mass_rel_change=float(abs(mass[-1] / mass[0] - 1)),
+        newton_iterations_mean=float(np.mean([r["newton_iterations"] for r in rows])),
+    )
+    run.analytic.update(half_width=a_h.tolist())
+    warn = run.metrics["solver"]["warnings"]
+    if judged.any() and err[judged].max() > 0.05:
+        warn.append(f"half-width differs from Hertz by {err[judged].max():.1%} (> 5 %) at a > 5 h")
+    if balance.max() > 1e-6:
+        warn.append(f"platen forces differ by {balance.max():.1e} relative (> 1e-6)")
+    if run.results["area_vs_points_rel_max"] > 0.01:
+        warn.append(f"level-set area and point volume differ by {run.results['area_vs_points_rel_max']:.1%}")
+    if any(r["mls_widened"] for r in run.records):
+        warn.append(f"MLS widened the support at {sum(r['mls_widened'] for r in run.records)} points")
+
+
+def plots(run, folder):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    p, rows = run.params, run.rows
+    F = np.array([r["force_top"] for r in rows])
+    Fs = np.linspace(0, F.max(), 200)
+    fig, ax = plt.subplots(figsize=(5, 4))
+    ax.plot(Fs, hertz_half_width(Fs, p["R"], p["E"], p["nu"]), "k-", label="Hertz")
+    ax.plot(F, [r["half_width_top"] for r in rows], "o", ms=3, label="top platen")
+    ax.plot(F, [r["half_width_bottom"] for r in rows], "x", ms=3, label="bottom platen")
+    ax.axhline(5 * p["h"], color="0.6", ls=":", label="5 h")
+    ax.set(xlabel="F (N/mm)", ylabel="a (mm)", title="Brazilian disc: contact half-width")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(folder / "half_width.png", dpi=120)
+    plt.close(fig)
+    pts = run.sim.points[1]
+    fig, ax = plt.subplots(figsize=(5, 4.5))
+    sc = ax.scatter(pts.x[:, 0], pts.x[:, 1], c=pts.stress[:, 1], s=1, cmap="viridis")
+    fig.colorbar(sc, label="sigma_yy (N/mm^2)")
+    ax.set(aspect="equal", title=f"sigma_yy at the material points, step {rows[-1]['step']}")
+    fig.tight_layout()
+    fig.savefig(folder / "sigma_yy.png", dpi=120)
+    plt.close(fig)
+
+
+def summary(run):
+    r = run.results
+    err = r["half_width_rel_error_max"]
+    return (
+        f"Brazilian disc: {len(run.rows)} steps, F = {r['force_top'][-1]:.6g} N/mm, "
+        f"a = {r['half_width'][-1][0]:.4g} mm (Hertz {run.analytic['half_width'][-1]:.4g}), "
+        f"max |a/a_Hertz - 1| over {r['steps_judged']} steps with a > 5 h: "
+        + ("n/a" if err is None else f"{err:.2%}")
+        + f", force balance {r['force_balance_rel_max']:.1e}, "
+        f"Newton {r['newton_iterations_mean']:.1f} per step"
+    )
+
+
+def main(argv=None):
+    args = parse(sys.argv[1:] if argv is None else argv)
+    params = vars(args)
+    return run_steps("brazilian", params, build, args.steps, row, COLUMNS, evaluate=evaluate,
+                     plots=plots, summary=summary, series_every=args.series_every)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

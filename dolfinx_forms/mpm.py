@@ -1,0 +1,355 @@
+"""The implicit level-set MPM step loop (section 4.4 of the seed paper).
+
+Each body is a level set on a fixed uniform background grid plus material points; obstacles are
+rigid level sets (`obstacles.py`). One load step:
+
+1. the cut scene of the current level sets (`build_scene`, supplied by the application, e.g.
+   `meshes.mpm.grid_scene`): active cells, integration points; Gamma_c and the closest points
+   come from the current grid level sets (eqs 21-25), never from the initial shapes;
+2. the material points' stress is projected to the integration points of the new cells by MLS
+   (eqs 38-45, `_cpp.MLSProjector`), per body, and enters the residual as the initial stress
+   int sigma_0 : grad v;
+3. the friction history is carried from the previous step's contact points to the new ones
+   (`transfer_friction`);
+4. Newton on the displacement increment du of the step (`ContactProblem`, penalty contact and
+   Coulomb friction, obstacles' motion and Dirichlet increments ramped with lam, cut-back);
+5. the material points move and update stress and volume (`material_points.update`);
+6. du is extended off each body along the normal (eq 20) and the level set advected by it
+   (eq 19, HJ-WENO5 + TVD-RK3), reinitialised when |grad phi| drifts; obstacles move.
+
+Nothing persistent changes before step 4 converges, and `snapshot`/`restore` copy every piece
+of state (points, level sets, obstacle poses, friction record, counters): a rejected step leaves
+the simulation exactly as it was.
+
+Small strain per step with the Jaumann update of the points' stress (material_points.py);
+laws must be linear (law_tangent). The background grid must be uniform (WENO5).
+"""
+
+from __future__ import annotations
+
+import time
+from contextlib import nullcontext
+from dataclasses import dataclass
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+
+from . import _cpp
+from . import material_points as mp
+from .boundary import Load
+from .laws import as_law
+from .newton import ContactSolverError  # noqa: F401  (raised by step)
+from .solver import ContactProblem, zone_ends
+
+
+@dataclass
+class MPMBody:
+    """A deformable body: name, cell tag, law (Law or (E, nu)) and initial shape (`_cpp.Shape`
+    sampled exactly at the grid nodes, or a `_cpp.LevelSet` on the background grid)."""
+
+    name: str
+    tag: int
+    law: object
+    shape: object
+
+
+def _stress_tensor(s):
+    return ufl.as_matrix([[s[0], s[2]], [s[2], s[1]]])
+
+
+class ImplicitMPM:
+    """Bodies and rigid obstacles over many load steps (module docstring).
+
+    grid: (xlines, ylines) of the uniform background grid; build_scene(levelsets) -> Scene: the
+    cut scene of {tag: _cpp.LevelSet} on that grid (bodies in the order of `bodies`); obstacles:
+    `RigidObstacle`s with their motion per step; dirichlet: `Dirichlet` conditions whose values
+    are the increments of one step (at lam = 1); reinit_drift: reinitialise a level set when
+    max | |grad phi| - 1 | within 3 h of its zero contour exceeds it. Other keywords go to
+    `ContactProblem` (mu, eps0, band, newton, petsc_options, ghost_penalty, ...)."""
+
+    def __init__(
+        self,
+        comm,
+        grid,
+        bodies,
+        build_scene,
+        *,
+        obstacles=(),
+        dirichlet=(),
+        reinit_drift=0.2,
+        timer=None,
+        log=print,
+        **problem_kw,
+    ):
+        self.comm = comm
+        self.xlines, self.ylines = (np.asarray(v, float) for v in grid)
+        self.grid = _cpp.StructuredGrid(self.xlines, self.ylines)
+        self.h = float(self.grid.max_spacing)
+        if not np.isclose(self.grid.min_spacing, self.h, rtol=1e-9):
+            raise ValueError("ImplicitMPM: the background grid must be uniform (WENO5 advection)")
+        self.bodies = list(bodies)
+        self.laws = {b.tag: as_law(b.law) for b in self.bodies}
+        self.C = {tag: mp.law_tangent(law) for tag, law in self.laws.items()}
+        self.levelsets = {}
+        for b in self.bodies:
+            if isinstance(b.shape, _cpp.LevelSet):
+                self.levelsets[b.tag] = _cpp.LevelSet(self.grid, b.shape.evaluate(self.grid.nodes())[0])
+            else:
+                self.levelsets[b.tag] = _cpp.levelset_from_shape(self.grid, b.shape)
+        self.build_scene = build_scene
+        self.obstacles = list(obstacles)
+        self.dirichlet = list(dirichlet)
+        self.reinit_drift = float(reinit_drift)
+        self.timer = timer
+        self.log = log if comm.rank == 0 else (lambda *a, **k: None)
+        self.problem_kw = problem_kw
+        self.points = None  # {tag: MaterialPoints}, seeded on the first scene
+        self.friction = {}  # pair key -> (points (n, 2), elastic tangential gap (n,))
+        self.step_count = 0
+        self.problem = None
+        self.scene = None
+
+    # ------------------------------------------------------------------ state
+    def phase(self, name):
+        return nullcontext() if self.timer is None else self.timer.phase(name)
+
+    def snapshot(self):
+        """Every piece of state a step changes (deep copies)."""
+        return dict(
+            points=None if self.points is None else {t: p.copy() for t, p in self.points.items()},
+            levelsets={t: _cpp.LevelSet(self.grid, l.values.ravel()) for t, l in self.levelsets.items()},
+            obstacles=[ob.state() for ob in self.obstacles],
+            friction={k: (x.copy(), e.copy()) for k, (x, e) in self.friction.items()},
+            step_count=self.step_count,
+        )
+
+    def restore(self, snap):
+        self.points = None if snap["points"] is None else {t: p.copy() for t, p in snap["points"].items()}
+        self.levelsets = {t: _cpp.LevelSet(self.grid, l.values.ravel()) for t, l in snap["levelsets"].items()}
+        for ob, s in zip(self.obstacles, snap["obstacles"]):
+            ob.set_state(s)
+        self.friction = {k: (x.copy(), e.copy()) for k, (x, e) in snap["friction"].items()}
+        self.step_count = snap["step_count"]
+
+    # ------------------------------------------------------------------ one step
+    def step(self):
+        """One load step (module docstring). Returns the step record (dict). On failure
+        (ContactSolverError, RuntimeError) the state is restored and the error re-raised."""
+        snap = self.snapshot()
+        try:
+            return self._step()
+        except Exception:
+            self.restore(snap)
+            raise
+
+    def _step(self):
+        t0 = time.perf_counter()
+        with self.phase("mesh"):
+            scene = self.build_scene(dict(self.levelsets))
+        sigma0 = None
+        if self.points is not None:
+            with self.phase("mls"):
+                sigma0, mls_info = self._project(scene)
+        else:
+            mls_info = {"widened": 0}
+        loads = []
+        if sigma0 is not None:
+            S = _stress_tensor(sigma0)
+            loads.append(
+                Load(lambda v, measure: -ufl.inner(S, ufl.grad(v)) * measure(None, degree=mp.DEGREE),
+                     scale=lambda lam: 1.0)
+            )
+        problem = ContactProblem(
+            scene,
+            self.laws,
+            dirichlet=self.dirichlet,
+            loads=loads,
+            obstacles=self.obstacles,
+            timer=self.timer,
+            log=self.log,
+            **self.problem_kw,
+        )
+        if self.points is None:
+            self.points = {b.tag: mp.seed(scene, problem.integration, b.tag) for b in self.bodies}
+        keys = problem.contact.names(scene)
+        with self.phase("contact"):
+            self._transfer_friction(problem, keys)
+        problem.solve(1, 1.0, label=f"MPM step {self.step_count + 1}")
+        # ---- converged: from here on the state changes
+        record = self._contact_record(problem, scene, keys)
+        with self.phase("points"):
+            outside = 0
+            moved = []
+            for b in self.bodies:
+                pts = self.points[b.tag]
+                du, grad, n_out = mp.displacement_at(problem, b.tag, pts.x, self.h)
+                mp.update(pts, du, grad, self.C[b.tag])
+                outside += n_out
+                moved.append(du)
+            if self.step_count == 0:
+                self.first_step_du = moved
+        with self.phase("evolution"):
+            evo = self._evolve(problem, scene)
+        for ob in self.obstacles:
+            ob.advance(1.0)
+        self.step_count += 1
+        self.problem, self.scene = problem, scene
+        imap = problem.V.dofmap.index_map
+        record.update(
+            step=self.step_count,
+            newton_iterations=int(sum(s.iterations for s in problem.steps)),
+            cutbacks=int(sum(s.cutback for s in problem.steps)),
+            num_dofs=int(imap.size_global * problem.bs),
+            num_cells=int(scene.mesh.topology.index_map(2).size_global),
+            points_outside_cells=outside,
+            mls_widened=mls_info["widened"],
+            mass={b.name: float(self.points[b.tag].vol0.sum()) for b in self.bodies},
+            volume_points={b.name: float(self.points[b.tag].vol.sum()) for b in self.bodies},
+            wall_s=time.perf_counter() - t0,
+            **evo,
+        )
+        return record
+
+    # ------------------------------------------------------------------ parts
+    def _project(self, scene):
+        """MLS projection of each body's point stress to the Gauss points (degree mp.DEGREE) of
+        its cells: a `Quadrature` vector function [s_xx, s_yy, s_xy]."""
+        mesh = scene.mesh
+        Qe = ufl.VectorElement("Quadrature", mesh.ufl_cell(), mp.DEGREE, dim=3, quad_scheme="default")
+        sigma0 = fem.Function(fem.FunctionSpace(mesh, Qe), name="sigma0")
+        qdofs = sigma0.function_space.dofmap.list.array.reshape(len(scene.cell_tags.values), -1)
+        arr = sigma0.x.array.reshape(-1, 3)
+        widened = 0
+        for b in self.bodies:
+            cells = scene.cell_tags.indices[scene.cell_tags.values == b.tag]
+            if len(cells) == 0:
+                continue
+            targets = mp.quadrature_points(scene, cells).reshape(-1, 2)
+            pts = self.points[b.tag]
+            r = _cpp.MLSProjector(pts.x, self.h).project(pts.stress, np.ascontiguousarray(targets))
+            arr[qdofs[cells].ravel()] = r["values"]
+            widened += int(np.sum(r["widening"] > 1))
+        widened = self.comm.allreduce(widened, op=MPI.SUM)
+        if widened:
+            self.log(f"MLS: {widened} integration points needed a wider support (reported)")
+        return sigma0, {"widened": widened}
+
+    def _transfer_friction(self, problem, keys):
+        """Each new contact point starts from the elastic tangential gap e_t = g_t - g_t^p of
+        the nearest contact point of the same pair in the previous step (moved with the
+        bodies) if one lies within h, else from zero tangential traction: its committed slip is
+        set to -e_t, so the trial traction at du = 0 is the old one (eq 11)."""
+        cs = problem.contact
+        if cs.mu == 0:
+            return
+        from scipy.spatial import cKDTree
+
+        for k, g in enumerate(cs.pairs):
+            old = self.friction.get(keys[k])
+            gtp = np.zeros(len(g.weights))
+            if old is not None and len(old[0]):
+                d, idx = cKDTree(old[0]).query(g.points)
+                near = d <= self.h
+                gtp[near] = -old[1][idx[near]]
+            cs.history[k].trial = gtp
+            cs.history[k].commit()
+            cs.slip_start[k] = gtp.copy()
+
+    def _contact_record(self, problem, scene, keys):
+        """Per pair: resultants, active zone, stick fraction; per obstacle: force and moment;
+        the friction record for the next step (points moved by the mean step displacement)."""
+        cs = problem.contact
+        pairs = []
+        self.friction = {}
+        for k, g in enumerate(cs.pairs):
+            s = cs.committed[k]
+            active = s["state"] != 0
+            w = g.weights
+            pn, pt = -s["tau_n"], s["tau_t"]
+            order = np.argsort(g.points[:, 0])
+            xl, xr = zone_ends(g.points[order, 0], active[order], s["g_n"][order])
+            wa = w[active]
+            pairs.append(
+                dict(
+                    body_i=keys[k][0],
+                    body_j=keys[k][1],
+                    x=float(np.average(g.points[active, 0], weights=wa)) if active.any() else 0.0,
+                    y=float(np.average(g.points[active, 1], weights=wa)) if active.any() else 0.0,
+                    normal_force=float(np.sum(w * pn)),
+                    tangential_force=float(np.sum(w * pt)),
+                    active_length=float(np.sum(wa)),
+                    stick_fraction=float(np.sum(w[s["state"] == 1]) / np.sum(wa)) if active.any() else 0.0,
+                    half_width=0.0 if xl is None else 0.5 * (xr - xl),
+                    num_points=int(len(w)),
+                )
+            )
+            if cs.mu > 0:
+                e_t = s["g_t"] - cs.history[k].committed
+                self.friction[keys[k]] = (g.points.copy(), np.asarray(e_t, float).copy())
+        # contact lives on one rank: share the records
+        pairs = [p for lst in self.comm.allgather(pairs) for p in lst]
+        self.friction = {k: v for d in self.comm.allgather(self.friction) for k, v in d.items()}
+        # contact resultants on each body: +sum w (tau_n n + tau_t t) on side i, the opposite on
+        # side j; moment about the body's material-point centroid
+        forces = {b.name: np.zeros(3) for b in self.bodies}
+        for k, g in enumerate(cs.pairs):
+            s = cs.committed[k]
+            f = (s["tau_n"][:, None] * g.normals + s["tau_t"][:, None] * g.tangents) * g.weights[:, None]
+            for sign, name, p in ((1.0, keys[k][0], g.p_i), (-1.0, keys[k][1], g.p_j)):
+                if name in forces:
+                    b = next(b for b in self.bodies if b.name == name)
+                    c = np.average(self.points[b.tag].x, axis=0, weights=self.points[b.tag].vol)
+                    r = p - c
+                    forces[name] += sign * np.array(
+                        [f[:, 0].sum(), f[:, 1].sum(), np.sum(r[:, 0] * f[:, 1] - r[:, 1] * f[:, 0])]
+                    )
+        body_forces = {n: self.comm.allreduce(v, op=MPI.SUM).tolist() for n, v in forces.items()}
+        res = cs.obstacle_resultants()
+        obstacles = {}
+        for ob in self.obstacles:
+            F, M = res[ob.name]
+            F = self.comm.allreduce(np.asarray(F, float), op=MPI.SUM)
+            obstacles[ob.name] = dict(fx=float(F[0]), fy=float(F[1]), moment=self.comm.allreduce(M, op=MPI.SUM))
+        return dict(pairs=pairs, obstacles=obstacles, body_forces=body_forces)
+
+    def _evolve(self, problem, scene):
+        """Extend du off each body (eq 20), advect its level set (eq 19), reinitialise on drift."""
+        V = problem.V
+        nx = len(self.xlines)
+        xdof = V.tabulate_dof_coordinates()[:, :2]
+        i = np.rint((xdof[:, 0] - self.xlines[0]) / self.h).astype(np.int64)
+        j = np.rint((xdof[:, 1] - self.ylines[0]) / self.h).astype(np.int64)
+        node = i + nx * j
+        owned = V.dofmap.index_map.size_local
+        cell_dofs = V.dofmap.list.array.reshape(-1, 4)
+        u = problem.u.x.array.reshape(-1, 2)
+        out = dict(area_levelset={}, advection_substeps={}, reinitialized={}, gradient_drift={})
+        nn = self.grid.num_nodes
+        self.grid_increments = {}
+        for b in self.bodies:
+            dofs = np.unique(cell_dofs[scene.cell_tags.find(b.tag)])
+            dofs = dofs[dofs < owned]
+            vel = np.zeros((nn, 2))
+            has = np.zeros(nn, np.int8)
+            vel[node[dofs]] = u[dofs]
+            has[node[dofs]] = 1
+            vel = self.comm.allreduce(vel, op=MPI.SUM)
+            has = self.comm.allreduce(has, op=MPI.MAX)
+            phi = self.levelsets[b.tag]
+            known = (has > 0) & (phi.values.ravel() <= 0)
+            vel = _cpp.extend_normal(self.grid, phi.values.ravel(), known.astype(np.int8), vel)
+            self.grid_increments[b.name] = vel
+            r = _cpp.advect_levelset(phi, np.ascontiguousarray(vel), 1.0, 0.5)
+            new = r["levelset"]
+            drift = float(_cpp.levelset_gradient_drift(new, 3 * self.h))
+            redo = drift > self.reinit_drift
+            if redo:
+                new = _cpp.reinitialize(new)
+            self.levelsets[b.tag] = new
+            out["area_levelset"][b.name] = float(_cpp.levelset_area(new))
+            out["advection_substeps"][b.name] = int(r["substeps"])
+            out["reinitialized"][b.name] = bool(redo)
+            out["gradient_drift"][b.name] = drift
+        return out

@@ -1,0 +1,245 @@
+"""Outputs of the multi-step (MPM) runs: step tables, time series, and the run skeleton.
+
+Files (the contract of ../shared/docs/benchmarks.md, "Multi-step and multi-body outputs"):
+`steps.csv` (the demo's columns), `contacts.csv` (step, body_i, body_j, x, y, normal_force,
+tangential_force, active_length, stick_fraction), `bodies.csv` (step, body, fx, fy, moment,
+area_levelset, volume_points), and two XDMF time series that ParaView opens:
+`material_points.xdmf` (the points at their current positions with stress, volume and
+displacement since the start) and `levelsets.xdmf` (the background grid with each body's level
+set and extended step displacement). The series store raw little-endian float64 files beside the
+.xdmf (XDMF "Binary" items; no HDF5 needed), one frame every `series_every` steps.
+
+`run_steps` is the skeleton of a multi-step demo, as `demo.run_case` is for one load path:
+metrics record and phase timer -> build the simulation -> steps (a ContactSolverError ends the
+run: one line on stderr, nothing written, exit status 1) -> evaluate (rank 0) -> one atomic
+folder -> summary and "results in ...".
+"""
+
+from __future__ import annotations
+
+import csv
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .newton import ContactSolverError
+from .results import PhaseTimer, new_metrics
+
+CONTACT_COLUMNS = [
+    "step",
+    "body_i",
+    "body_j",
+    "x",
+    "y",
+    "normal_force",
+    "tangential_force",
+    "active_length",
+    "stick_fraction",
+]
+BODY_COLUMNS = ["step", "body", "fx", "fy", "moment", "area_levelset", "volume_points"]
+
+
+def write_csv(path, columns, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(columns)
+        for r in rows:
+            w.writerow([r[c] for c in columns])
+
+
+class Series:
+    """An XDMF temporal collection of frames, each with its own geometry (module docstring)."""
+
+    def __init__(self, name):
+        self.name, self.frames = name, []
+
+    def add(self, time_value, points, point_data, cells=None):
+        """points (n, 2); point_data {name: (n,) or (n, c)}; cells (m, 4) quadrilaterals in
+        DOLFINx order, or None for a cloud of points."""
+        self.frames.append((float(time_value), np.asarray(points, float), point_data, cells))
+
+    def write(self, folder):
+        folder = Path(folder)
+        grids = []
+        for k, (t, x, data, cells) in enumerate(self.frames):
+            n = len(x)
+            xyz = np.zeros((n, 3))
+            xyz[:, : x.shape[1]] = x
+            items = [self._blob(folder, f"{k}_geometry", xyz)]
+            if cells is None:
+                topo = f'<Topology TopologyType="Polyvertex" NumberOfElements="{n}" />'
+            else:
+                vtk = np.ascontiguousarray(np.asarray(cells)[:, [0, 1, 3, 2]], dtype=np.int64)
+                topo = (
+                    f'<Topology TopologyType="Quadrilateral" NumberOfElements="{len(vtk)}">'
+                    + self._item(folder, f"{k}_topology", vtk)
+                    + "</Topology>"
+                )
+            attrs = []
+            for name, v in data.items():
+                v = np.asarray(v, float)
+                kind = "Scalar" if v.ndim == 1 else "Vector" if v.shape[1] <= 3 else "Tensor"
+                if kind == "Vector" and v.shape[1] == 2:
+                    v = np.hstack([v, np.zeros((n, 1))])
+                attrs.append(
+                    f'<Attribute Name="{name}" AttributeType="{kind}" Center="Node">'
+                    + self._item(folder, f"{k}_{name}", v)
+                    + "</Attribute>"
+                )
+            grids.append(
+                f'<Grid Name="frame{k}" GridType="Uniform"><Time Value="{t:.17g}" />{topo}'
+                f'<Geometry GeometryType="XYZ">{items[0]}</Geometry>{"".join(attrs)}</Grid>'
+            )
+        text = (
+            '<?xml version="1.0"?>\n<Xdmf Version="3.0"><Domain>'
+            f'<Grid Name="{self.name}" GridType="Collection" CollectionType="Temporal">'
+            + "\n".join(grids)
+            + "</Grid></Domain></Xdmf>\n"
+        )
+        (folder / f"{self.name}.xdmf").write_text(text)
+
+    def _blob(self, folder, key, a):
+        return self._item(folder, key, a)
+
+    def _item(self, folder, key, a):
+        a = np.ascontiguousarray(a)
+        fname = f"{self.name}_{key}.bin"
+        a.astype(a.dtype.newbyteorder("<")).tofile(folder / fname)
+        dtype, prec = ("Int", 8) if a.dtype.kind == "i" else ("Float", 8)
+        dims = " ".join(str(d) for d in a.shape)
+        return (
+            f'<DataItem Dimensions="{dims}" NumberType="{dtype}" Precision="{prec}" '
+            f'Format="Binary" Endian="Little">{fname}</DataItem>'
+        )
+
+
+def add_frames(sim, points_series, grid_series, step, x0):
+    """One frame of both series from the simulation's current state (rank 0 calls it; the
+    points and level sets are replicated). x0: {tag: initial point positions}."""
+    for b in sim.bodies:
+        pts = sim.points[b.tag]
+        data = {"stress": pts.stress, "volume": pts.vol, "displacement": pts.x - x0[b.tag]}
+        points_series.setdefault(b.name, Series(f"material_points_{b.name}")).add(step, pts.x, data)
+    nx, ny = len(sim.xlines), len(sim.ylines)
+    X, Y = np.meshgrid(sim.xlines, sim.ylines)
+    v = (np.arange(ny - 1)[:, None] * nx + np.arange(nx - 1)[None, :]).ravel()
+    quads = np.stack([v, v + 1, v + nx, v + nx + 1], axis=1)
+    data = {f"phi_{b.name}": sim.levelsets[b.tag].values.ravel() for b in sim.bodies}
+    for name, du in getattr(sim, "grid_increments", {}).items():
+        data[f"du_{name}"] = du
+    grid_series.add(step, np.stack([X.ravel(), Y.ravel()], axis=1), data, quads)
+
+
+@dataclass
+class StepRun:
+    """State of a multi-step run handed to the callbacks of `run_steps`."""
+
+    name: str
+    comm: object
+    metrics: dict
+    timer: PhaseTimer
+    sim: object = None
+    records: list = field(default_factory=list)  # ImplicitMPM.step records
+    rows: list = field(default_factory=list)  # steps.csv rows
+    data: dict = field(default_factory=dict)
+
+    @property
+    def params(self):
+        return self.metrics["parameters"]
+
+    @property
+    def results(self):
+        return self.metrics["results"]
+
+    @property
+    def analytic(self):
+        return self.metrics["analytic"]
+
+
+def run_steps(
+    name,
+    params,
+    build,
+    num_steps,
+    row,
+    columns,
+    *,
+    evaluate=None,
+    plots=None,
+    summary=None,
+    series_every=10,
+    comm=None,
+    prog=None,
+):
+    """A multi-step demo (module docstring). build(run) -> ImplicitMPM (timed as "mesh" only
+    for what it does itself); row(run, record) -> the steps.csv row {column: value};
+    evaluate(run) on rank 0 fills results/analytic and solver warnings; plots(run, folder) on
+    rank 0. Returns the exit status."""
+    from mpi4py import MPI
+
+    from .folders import atomic_output_dir
+    from .results import write_metrics
+
+    comm = MPI.COMM_WORLD if comm is None else comm
+    prog = prog or Path(sys.argv[0]).name
+    metrics = new_metrics(name, "cut", params)
+    run = StepRun(name, comm, metrics, PhaseTimer(metrics))
+    points_series, grid_series = {}, Series("levelsets")
+    try:
+        run.sim = build(run)
+        x0 = None
+        for k in range(num_steps):
+            rec = run.sim.step()
+            run.records.append(rec)
+            run.rows.append(row(run, rec))
+            if x0 is None:  # positions at seeding: the first step's points before it moved
+                x0 = {t: p.x - d for (t, p), d in zip(run.sim.points.items(), run.sim.first_step_du)}
+            if comm.rank == 0 and ((k + 1) % series_every == 0 or k + 1 == num_steps or k == 0):
+                add_frames(run.sim, points_series, grid_series, rec["step"], x0)
+    except ContactSolverError as e:
+        if comm.rank == 0:
+            sys.stderr.write(f"{prog}: step {len(run.records) + 1}: {e}\n")
+        return 1
+    last = run.records[-1]
+    metrics["mesh"].update(h_contact=run.sim.h, num_cells=last["num_cells"], num_dofs=last["num_dofs"])
+    metrics["solver"].update(
+        load_steps=len(run.records),
+        newton_iterations=[r["newton_iterations"] for r in run.records],
+        converged=True,
+        residual_history=[],
+        penalty={"eps_n": run.sim.problem.eps_n, "eps_t": run.sim.problem.eps_t},
+        cutbacks=int(sum(r["cutbacks"] for r in run.records)),
+        warnings=[],
+    )
+    if evaluate is not None and comm.rank == 0:
+        evaluate(run)
+    run.timer.stop()
+    run.metrics = metrics = comm.bcast(metrics if comm.rank == 0 else None, root=0)
+    contacts = [dict(step=r["step"], **{c: p[c] for c in CONTACT_COLUMNS[1:]}) for r in run.records for p in r["pairs"]]
+    bodies = [
+        dict(step=r["step"], body=b.name, fx=r["body_forces"][b.name][0], fy=r["body_forces"][b.name][1],
+             moment=r["body_forces"][b.name][2], area_levelset=r["area_levelset"][b.name],
+             volume_points=r["volume_points"][b.name])
+        for r in run.records for b in run.sim.bodies
+    ]
+    with atomic_output_dir(params["out"], comm, force=params.get("force", False)) as folder:
+        folder = Path(folder)
+        if comm.rank == 0:
+            write_csv(folder / "steps.csv", columns, run.rows)
+            write_csv(folder / "contacts.csv", CONTACT_COLUMNS, contacts)
+            write_csv(folder / "bodies.csv", BODY_COLUMNS, bodies)
+            for s in list(points_series.values()) + [grid_series]:
+                s.write(folder)
+            if plots is not None:
+                plots(run, folder)
+            write_metrics(folder, metrics)
+    if comm.rank == 0:
+        for w in metrics["solver"]["warnings"]:
+            print(f"WARNING: {w}")
+        if summary is not None:
+            print(summary(run) if callable(summary) else summary.format(**metrics))
+        print(f"results in {Path(params['out']).resolve()}")
+    return 0
