@@ -224,6 +224,13 @@ def pair_geometry(
         return None
     n = np.maximum(np.ceil((box[1] - box[0]) / dx).astype(int), 3)
     hi = box[0] + n * dx  # keep the spacing exactly dx
+    for b in (bi, bj):  # a grid level set is known on its grid only: stay inside it
+        if not isinstance(b, RigidObstacle) and isinstance(b.shape, _cpp.LevelSet):
+            g = b.shape.grid
+            glo, ghi = np.array([g.x[0], g.y[0]]), np.array([g.x[-1], g.y[-1]])
+            box[0] = np.maximum(box[0], glo)
+            n = np.maximum(np.floor((np.minimum(hi, ghi) - box[0]) / dx).astype(int), 3)
+            hi = np.minimum(box[0] + n * dx, ghi)
     grid = _cpp.StructuredGrid(
         np.linspace(box[0, 0], hi[0], n[0] + 1), np.linspace(box[0, 1], hi[1], n[1] + 1)
     )

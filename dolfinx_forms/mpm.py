@@ -338,7 +338,13 @@ class ImplicitMPM:
             vel = self.comm.allreduce(vel, op=MPI.SUM)
             has = self.comm.allreduce(has, op=MPI.MAX)
             phi = self.levelsets[b.tag]
-            known = (has > 0) & (phi.values.ravel() <= 0)
+            # known: every node of the body's active cells. The FE increment on the outside
+            # nodes of cut cells is the unfitted method's own (smooth, ghost-penalised)
+            # extension, second order at the interface; the constant normal extension of
+            # eq 20 fills the rest of the grid. (Extending from the inside nodes only would move
+            # the interface by du at a node up to h inside: first order, and the level set
+            # would lag the material by ~ h grad(du) per step.)
+            known = has > 0
             vel = _cpp.extend_normal(self.grid, phi.values.ravel(), known.astype(np.int8), vel)
             self.grid_increments[b.name] = vel
             r = _cpp.advect_levelset(phi, np.ascontiguousarray(vel), 1.0, 0.5)

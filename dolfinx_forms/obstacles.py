@@ -56,7 +56,7 @@ class RigidObstacle:
             if not isinstance(self.shape, _cpp.LevelSet):
                 raise ValueError(f"RigidObstacle {self.name!r}: bbox is required for a Shape")
             g = self.shape.grid
-            self.bbox = np.array([[g.axis(0)[0], g.axis(1)[0]], [g.axis(0)[-1], g.axis(1)[-1]]])
+            self.bbox = np.array([[g.x[0], g.y[0]], [g.x[-1], g.y[-1]]])
         self.bbox0 = np.asarray(self.bbox, float).reshape(2, 2)
         self.center = np.asarray(self.center, float)
         self.translation = np.asarray(self.translation, float)
