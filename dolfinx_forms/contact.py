@@ -137,11 +137,13 @@ class GridLocator:
     (cells, X, outside) like BodyLocator: outside = 0 inside a cell, else the distance to it
     (inf and cell -1 when nothing is within max_distance)."""
 
-    def __init__(self, mesh, cell_tags, tag, cut, degree):
+    def __init__(self, mesh, cell_tags, tag, cut, degree, owned_only=False):
         self.xl, self.yl = np.asarray(cut.xlines), np.asarray(cut.ylines)
         self.table = np.full((len(self.xl) - 1, len(self.yl) - 1), -1, np.int32)
         g = mesh.geometry.dofmap.array.reshape(-1, 4)
         cells = cell_tags.indices[cell_tags.values == tag].astype(np.int32)
+        if owned_only:  # e.g. to take each point's value from one rank, partition-independently
+            cells = cells[cells < mesh.topology.index_map(2).size_local]
         xv = mesh.geometry.x[g[cells], :2]  # (n, 4, 2)
         self.v0, self.ex, self.ey = xv[:, 0], xv[:, 1] - xv[:, 0], xv[:, 2] - xv[:, 0]
         centre = xv.mean(axis=1)
@@ -224,10 +226,21 @@ def pair_geometry(
         return None
     n = np.maximum(np.ceil((box[1] - box[0]) / dx).astype(int), 3)
     hi = box[0] + n * dx  # keep the spacing exactly dx
+    # the boxes' overlap before the band's inflation (touching boxes give a flat one)
+    core = np.array(
+        [np.maximum(_bbox(bi)[0], _bbox(bj)[0]), np.minimum(_bbox(bi)[1], _bbox(bj)[1])]
+    )
+    core = core if np.all(core[0] <= core[1]) else None
     for b in (bi, bj):  # a grid level set is known on its grid only: stay inside it
         if not isinstance(b, RigidObstacle) and isinstance(b.shape, _cpp.LevelSet):
             g = b.shape.grid
             glo, ghi = np.array([g.x[0], g.y[0]]), np.array([g.x[-1], g.y[-1]])
+            tol = 1e-9 * np.max(ghi - glo)
+            if core is not None and (np.any(core[0] < glo - tol) or np.any(core[1] > ghi + tol)):
+                raise ValueError(
+                    f"body {b.name!r}: its level-set grid {[glo.tolist(), ghi.tolist()]} does "
+                    f"not cover the contact search box {core.tolist()}"
+                )
             box[0] = np.maximum(box[0], glo)
             n = np.maximum(np.floor((np.minimum(hi, ghi) - box[0]) / dx).astype(int), 3)
             hi = np.minimum(box[0] + n * dx, ghi)

@@ -32,7 +32,8 @@ from mpi4py import MPI
 
 from . import _cpp
 from .contact import GridLocator
-from .cut import CUT
+from .cut import CUT, shape_values
+from .parallel import allreduce_array
 
 DEGREE = 4  # 3x3 Gauss points per cell: the cut cells' rule (cut.CutIntegration)
 
@@ -92,6 +93,17 @@ def quadrature_points(scene, cells, degree=DEGREE):
     return o[:, None, :] + X[None, :, :] * e[:, None, :]
 
 
+def _canonical(scene, cells):
+    """Corner (n, 2), extents (n, 2) and the permutation (n, 4) that puts each cell's vertices
+    in tensor order (x-fastest) by their coordinates: the same points for a cell whatever the
+    vertex order of its partition (1 and 2 ranks seed identical points)."""
+    g = scene.mesh.geometry.dofmap.array.reshape(-1, 4)[cells]
+    x = scene.mesh.geometry.x[g][:, :, :2]
+    lo, hi = x.min(axis=1), x.max(axis=1)
+    key = (x[:, :, 0] > 0.5 * (lo + hi)[:, None, 0]) + 2 * (x[:, :, 1] > 0.5 * (lo + hi)[:, None, 1])
+    return lo, hi - lo, np.argsort(key, axis=1)
+
+
 def seed(scene, integration, tag):
     """Material points of body `tag` at the positive integration points of its active cells
     (owned cells of every rank, gathered), zero stress."""
@@ -102,17 +114,23 @@ def seed(scene, integration, tag):
     kind = integration.kind[cells]
     X, w = basix.make_quadrature(basix.CellType.quadrilateral, DEGREE)
     inner = cells[kind != CUT]
-    o, e = _cell_frames(scene, inner)
+    o, e, _ = _canonical(scene, inner)
     xs = [(o[:, None, :] + X[None] * e[:, None, :]).reshape(-1, 2)]
     vs = [(w[None, :] * np.prod(e, axis=1)[:, None]).ravel()]
     cut = cells[kind == CUT]
     if len(cut):
-        pdofs = integration.phi.function_space.dofmap.list.array.reshape(-1, 4)[cut]
-        q = _cpp.cut_quadrature(np.ascontiguousarray(integration.phi.x.array[pdofs]), 2)
+        o, e, perm = _canonical(scene, cut)
+        # phi at the exact vertex coordinates (not the dof coordinates, which carry round-off
+        # that differs with the partition and flips the sign of phi at a vertex on the contour)
+        g = scene.mesh.geometry.dofmap.array.reshape(-1, 4)[cut]
+        xv = np.take_along_axis(g, perm, axis=1).ravel()
+        phi = shape_values(scene.cut.levelsets[tag], scene.mesh.geometry.x[xv, :2]).reshape(-1, 4)
+        q = _cpp.cut_quadrature(np.ascontiguousarray(phi), 2)
         owner = np.repeat(np.arange(len(cut)), np.diff(q["offsets"]))
-        o, e = _cell_frames(scene, cut)
-        xs.append(o[owner] + q["points"] * e[owner])
-        vs.append(q["weights"] * np.prod(e, axis=1)[owner])
+        # sub-triangles of zero area (a contour through a vertex) carry no mass: no point
+        keep = q["weights"] > 1e-12
+        xs.append((o[owner] + q["points"] * e[owner])[keep])
+        vs.append((q["weights"] * np.prod(e, axis=1)[owner])[keep])
     x = np.concatenate(comm.allgather(np.concatenate(xs)))
     vol = np.concatenate(comm.allgather(np.concatenate(vs)))
     return MaterialPoints(int(tag), x, vol.copy(), vol.copy(), np.zeros((len(vol), 3)))
@@ -126,11 +144,13 @@ def displacement_at(problem, tag, points, max_distance):
     if a point is further than max_distance from every cell."""
     scene, V = problem.scene, problem.V
     comm = scene.mesh.comm
-    loc = GridLocator(scene.mesh, scene.cell_tags, tag, scene.cut, 1)
+    # each rank's best owned cell, then the nearest over the ranks (ties: the lowest rank):
+    # the same cell as on one rank whatever the partition
+    loc = GridLocator(scene.mesh, scene.cell_tags, tag, scene.cut, 1, owned_only=True)
     cells, X, outside = loc.locate(points, max_distance)
-    owned = scene.mesh.topology.index_map(2).size_local
-    mine = (cells >= 0) & (cells < owned)
-    chosen = comm.allreduce(np.where(mine, comm.rank, comm.size), op=MPI.MIN)
+    best = allreduce_array(comm, outside, MPI.MIN)
+    mine = (cells >= 0) & (outside == best)
+    chosen = allreduce_array(comm, np.where(mine, comm.rank, comm.size).astype(np.int32), MPI.MIN)
     lost = np.flatnonzero(chosen == comm.size)
     if len(lost):
         raise RuntimeError(
@@ -148,7 +168,7 @@ def displacement_at(problem, tag, points, max_distance):
     gx = np.einsum("na,nac->nc", tab[1, :, :, 0], uloc) / e[:, :1]
     gy = np.einsum("na,nac->nc", tab[2, :, :, 0], uloc) / e[:, 1:]
     val[take, 2:] = np.stack([gx[:, 0], gy[:, 0], gx[:, 1], gy[:, 1]], axis=1)
-    val = comm.allreduce(val, op=MPI.SUM)
+    val = allreduce_array(comm, val, MPI.SUM)
     grad = val[:, 2:].reshape(-1, 2, 2)  # grad[:, c, d] = du_c / dx_d
     n_out = comm.allreduce(int(np.sum(outside[take] > 0)), op=MPI.SUM)
     return val[:, :2], grad, n_out

@@ -40,6 +40,7 @@ from . import _cpp
 from . import material_points as mp
 from .boundary import Load
 from .laws import as_law
+from .parallel import allreduce_array
 from .newton import ContactSolverError  # noqa: F401  (raised by step)
 from .solver import ContactProblem, zone_ends
 
@@ -305,12 +306,12 @@ class ImplicitMPM:
                     forces[name] += sign * np.array(
                         [f[:, 0].sum(), f[:, 1].sum(), np.sum(r[:, 0] * f[:, 1] - r[:, 1] * f[:, 0])]
                     )
-        body_forces = {n: self.comm.allreduce(v, op=MPI.SUM).tolist() for n, v in forces.items()}
+        body_forces = {n: allreduce_array(self.comm, v, MPI.SUM).tolist() for n, v in forces.items()}
         res = cs.obstacle_resultants()
         obstacles = {}
         for ob in self.obstacles:
             F, M = res[ob.name]
-            F = self.comm.allreduce(np.asarray(F, float), op=MPI.SUM)
+            F = allreduce_array(self.comm, np.asarray(F, float), MPI.SUM)
             obstacles[ob.name] = dict(fx=float(F[0]), fy=float(F[1]), moment=self.comm.allreduce(M, op=MPI.SUM))
         return dict(pairs=pairs, obstacles=obstacles, body_forces=body_forces)
 
@@ -335,8 +336,8 @@ class ImplicitMPM:
             has = np.zeros(nn, np.int8)
             vel[node[dofs]] = u[dofs]
             has[node[dofs]] = 1
-            vel = self.comm.allreduce(vel, op=MPI.SUM)
-            has = self.comm.allreduce(has, op=MPI.MAX)
+            vel = allreduce_array(self.comm, vel, MPI.SUM)
+            has = allreduce_array(self.comm, has, MPI.MAX)
             phi = self.levelsets[b.tag]
             # known: every node of the body's active cells. The FE increment on the outside
             # nodes of cut cells is the unfitted method's own (smooth, ghost-penalised)

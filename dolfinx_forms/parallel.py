@@ -17,6 +17,8 @@ import os
 import sys
 import traceback
 
+import numpy as np
+
 from .logs import env_verbose
 
 MAX_MESSAGE = 2000  # characters of the exception message kept on the line
@@ -59,3 +61,12 @@ def install() -> bool:
     if sys.excepthook is sys.__excepthook__:
         sys.excepthook = excepthook
     return sys.excepthook is excepthook
+
+
+def allreduce_array(comm, a, op):
+    """Element-wise MPI reduction of a numpy array (buffer based: the pickled `allreduce`
+    compares whole arrays for MIN/MAX)."""
+    a = np.ascontiguousarray(a)
+    out = np.empty_like(a)
+    comm.Allreduce(a, out, op=op)
+    return out

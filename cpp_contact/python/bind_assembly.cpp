@@ -70,8 +70,8 @@ void bind_assembly(py::module_& m) {
                             {py::ssize_t(q.u_j_prescribed.size() / 2), 2});
           },
           [](ContactQuadrature& q, const carray& v) {
-            if (v.size() != 0 and (v.ndim() != 2 or v.shape(0) != py::ssize_t(q.size()) or
-                                   v.shape(1) != 2))
+            if (v.size() != 0 and
+                (v.ndim() != 2 or v.shape(0) != py::ssize_t(q.size()) or v.shape(1) != 2))
               throw std::invalid_argument("u_j_prescribed: expected shape (nq, 2) or empty");
             q.u_j_prescribed = copy_of(v);
           },
