@@ -148,12 +148,14 @@ def plots(run, folder):
     fig.tight_layout()
     fig.savefig(folder / "half_width.png", dpi=120)
     plt.close(fig)
-    pts = run.sim.points[1]
-    fig, ax = plt.subplots(figsize=(5, 4.5))
-    sc = ax.scatter(pts.x[:, 0], pts.x[:, 1], c=pts.stress[:, 1], s=1, cmap="viridis")
-    fig.colorbar(sc, label="sigma_yy (N/mm^2)")
-    ax.set(aspect="equal", title=f"sigma_yy at the material points, step {rows[-1]['step']}")
-    fig.tight_layout()
+    frames = run.data["series"]["disc"].frames  # (step, x, {stress, ...}, cells)
+    frames = [frames[k] for k in sorted({0, len(frames) // 3, 2 * len(frames) // 3, len(frames) - 1})]
+    fig, axes = plt.subplots(1, len(frames), figsize=(3.2 * len(frames), 3.4), squeeze=False)
+    lo = min(f[2]["stress"][:, 1].min() for f in frames)
+    for ax, (step, x, data, _) in zip(axes[0], frames):
+        sc = ax.scatter(x[:, 0], x[:, 1], c=data["stress"][:, 1], s=0.5, cmap="viridis", vmin=lo, vmax=0)
+        ax.set(aspect="equal", title=f"step {step:g}", xticks=[], yticks=[])
+    fig.colorbar(sc, ax=axes[0].tolist(), label="sigma_yy at the material points (N/mm^2)")
     fig.savefig(folder / "sigma_yy.png", dpi=120)
     plt.close(fig)
 

@@ -188,6 +188,7 @@ def run_steps(
     metrics = new_metrics(name, "cut", params)
     run = StepRun(name, comm, metrics, PhaseTimer(metrics))
     points_series, grid_series = {}, Series("levelsets")
+    run.data["series"] = points_series  # {body name: Series} of the material points (rank 0)
     try:
         run.sim = build(run)
         x0 = None
