@@ -11,6 +11,7 @@ void bind_location(py::module_& m);
 void bind_cut(py::module_& m);
 void bind_mls(py::module_& m);
 void bind_evolution(py::module_& m);
+void bind_broad_phase(py::module_& m);
 
 PYBIND11_MODULE(_cpp, m) {
   m.doc() = "ILS contact core: level sets, closest points, contact surface, return mapping";
@@ -21,4 +22,5 @@ PYBIND11_MODULE(_cpp, m) {
   bind_cut(m);
   bind_mls(m);
   bind_evolution(m);
+  bind_broad_phase(m);
 }
