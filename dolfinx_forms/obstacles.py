@@ -30,7 +30,8 @@ class RigidObstacle:
     """A rigid obstacle (see the module docstring).
 
     name: for output; shape: `_cpp.Shape` or `_cpp.LevelSet` (phi < 0 inside) in the obstacle's
-    frame; bbox: (2, 2) bounding box in that frame (None: the LevelSet's grid box; required for
+    frame (a LevelSet's grid must contain the obstacle with a margin: beyond it the value is
+    extended by the distance to the grid); bbox: (2, 2) bounding box in that frame (None: the LevelSet's grid box; required for
     a Shape); center: the point the rotation turns about (and the moment is taken about);
     translation, rotation: the prescribed motion per step (a (2,) vector and an angle in
     radians, counter-clockwise); bodies: tags of the deformable bodies it may touch (None:
@@ -118,7 +119,12 @@ class RigidObstacle:
         X = np.ascontiguousarray(self.pull_back(x))
         if isinstance(self.shape, _cpp.Shape):
             return np.asarray(self.shape(X))
-        return self.shape.evaluate(X)[0]
+        # beyond its grid (which must hold the whole obstacle): the value at the nearest grid
+        # point plus the distance to the grid, continuous and positive there
+        g = self.shape.grid
+        lo, hi = np.array([g.x[0], g.y[0]]), np.array([g.x[-1], g.y[-1]])
+        Xc = np.clip(X, lo, hi)
+        return self.shape.evaluate(np.ascontiguousarray(Xc))[0] + np.linalg.norm(X - Xc, axis=1)
 
     def levelset(self, grid):
         """The obstacle's level set on a `_cpp.StructuredGrid` (node values of the current

@@ -6,6 +6,7 @@ import importlib.util
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 _spec = importlib.util.spec_from_file_location(
@@ -52,3 +53,19 @@ def test_bad_input_exits_2_naming_the_parameter(args, word, tmp_path, capsys):
     assert e.value.code == 2
     assert word in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+
+
+def test_time_series_reference_their_data(tmp_path):
+    """The XDMF series are well-formed and every Binary item names a file of its size."""
+    import xml.etree.ElementTree as ET
+
+    out = tmp_path / "bd"
+    assert demo.main(["--h", "1", "--steps", "2", "--series-every", "1", "--out", str(out)]) == 0
+    for name in ("material_points_disc.xdmf", "levelsets.xdmf"):
+        root = ET.parse(out / name).getroot()
+        frames = root.findall(".//Grid[@GridType='Uniform']")
+        assert len(frames) == 2
+        for item in root.iter("DataItem"):
+            dims = [int(d) for d in item.get("Dimensions").split()]
+            size = (out / item.text).stat().st_size
+            assert size == 8 * int(np.prod(dims)), item.text

@@ -119,8 +119,7 @@ std::vector<std::int32_t> flatten_sorted(std::vector<std::array<std::int32_t, 2>
 
 } // namespace
 
-std::vector<std::int32_t> candidate_pairs(std::span<const double> boxes, int dim,
-                                          double inflate) {
+std::vector<std::int32_t> candidate_pairs(std::span<const double> boxes, int dim, double inflate) {
   check_boxes(boxes, dim, "boxes");
   check_inflate(inflate);
   const auto ib = inflated(boxes, dim, inflate);
