@@ -117,6 +117,9 @@ def evaluate(run):
         area_vs_points_rel_max=float(np.max(np.abs(area / vol - 1))),
         mass_rel_change=float(abs(mass[-1] / mass[0] - 1)),
         newton_iterations_mean=float(np.mean([r["newton_iterations"] for r in rows])),
+        reinitializations=int(sum(r["reinitialized"]["disc"] for r in run.records)),
+        gradient_drift_max=float(max(r["gradient_drift"]["disc"] for r in run.records)),
+        points_outside_cells_max=int(max(r["points_outside_cells"] for r in run.records)),
     )
     run.analytic.update(half_width=a_h.tolist())
     warn = run.metrics["solver"]["warnings"]
