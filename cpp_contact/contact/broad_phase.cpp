@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
-#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -67,46 +66,168 @@ bool overlap(const double* a, const double* b, int dim) {
   return true;
 }
 
-/// @brief Axis of largest variance of the box centres (over both sets): the sweep along it
-/// sees the fewest spurious interval overlaps for a spread-out assembly.
+/// @brief Axis of largest variance of the box centres of both sets: the sweep along it sees the
+/// fewest spurious interval overlaps for a spread-out assembly.
 int sweep_axis(std::span<const double> a, std::span<const double> b, int dim) {
-  const std::size_t stride = 2 * std::size_t(dim);
-  const std::size_t n = (a.size() + b.size()) / stride;
-  if (dim == 1 or n < 2)
-    return 0;
+  const std::size_t stride = 2 * std::size_t(dim), n = (a.size() + b.size()) / stride;
   int best = 0;
   double best_var = -1.0;
-  for (int k = 0; k < dim; ++k) {
-    // Two-pass mean/variance: the centres may sit far from the origin.
-    double mean = 0.0;
+  for (int k = 0; k < dim and n > 1; ++k) {
+    const auto centre = [&](std::span<const double> s, std::size_t i) {
+      return 0.5 * (s[stride * i + std::size_t(k)] + s[stride * i + std::size_t(dim + k)]);
+    };
+    // Two passes: the centres may sit far from the origin.
+    double mean = 0.0, var = 0.0;
     for (auto s : {a, b})
       for (std::size_t i = 0; i < s.size() / stride; ++i)
-        mean += 0.5 * (s[stride * i + std::size_t(k)] + s[stride * i + std::size_t(dim + k)]);
+        mean += centre(s, i);
     mean /= double(n);
-    double var = 0.0;
     for (auto s : {a, b})
-      for (std::size_t i = 0; i < s.size() / stride; ++i) {
-        const double c =
-            0.5 * (s[stride * i + std::size_t(k)] + s[stride * i + std::size_t(dim + k)]) - mean;
-        var += c * c;
-      }
+      for (std::size_t i = 0; i < s.size() / stride; ++i)
+        var += (centre(s, i) - mean) * (centre(s, i) - mean);
     if (var > best_var)
       best_var = var, best = k;
   }
   return best;
 }
 
-/// @brief Box indices sorted by their lower bound along `axis` (ties by index: deterministic).
-std::vector<std::int32_t> sorted_by_lo(const std::vector<double>& boxes, int dim, int axis) {
-  const std::size_t stride = 2 * std::size_t(dim);
-  std::vector<std::int32_t> order(boxes.size() / stride);
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](std::int32_t i, std::int32_t j) {
-    const double li = boxes[stride * std::size_t(i) + std::size_t(axis)];
-    const double lj = boxes[stride * std::size_t(j) + std::size_t(axis)];
-    return li < lj or (li == lj and i < j);
+/// @brief The sweep axis and a uniform grid of cells over the other (secondary) axes.
+///
+/// A plain sweep along one axis visits every pair whose intervals overlap along that axis:
+/// for n grains spread over a square that is O(n^1.5) (each interval meets a whole column of
+/// grains). Sweeping each cell of a grid over the secondary axes separately, with cells about
+/// one box wide, leaves O(1) interval overlaps per box: O(n log n + pairs) overall.
+struct Cells {
+  int dim = 1, axis = 0;
+  std::vector<int> sec;             ///< secondary axes
+  std::vector<double> origin, size; ///< per secondary axis
+  std::vector<std::int64_t> count;  ///< cells per secondary axis
+  std::vector<std::int64_t> stride; ///< linear key = sum index[s] * stride[s]
+
+  /// Cell index of coordinate x along secondary axis s (monotone in x, clamped).
+  std::int64_t index(std::size_t s, double x) const {
+    const double t = std::floor((x - origin[s]) / size[s]);
+    return std::int64_t(std::clamp(t, 0.0, double(count[s] - 1)));
+  }
+
+  /// Key of the cell holding the lower corner of the intersection of two overlapping boxes:
+  /// it lies in both boxes, so both are registered in that cell, and the pair is reported
+  /// there only (exactly once).
+  std::int64_t owner(const double* a, const double* b) const {
+    std::int64_t key = 0;
+    for (std::size_t s = 0; s < sec.size(); ++s)
+      key += stride[s] * index(s, std::max(a[sec[s]], b[sec[s]]));
+    return key;
+  }
+};
+
+/// @brief Grid for the (inflated) boxes of both sets: cells of the median box extent, at most
+/// about 2 n^(1/(d-1)) per axis (points or huge outliers do not blow the cell count up).
+Cells make_cells(std::span<const double> a, std::span<const double> b, int dim) {
+  Cells c;
+  c.dim = dim;
+  c.axis = sweep_axis(a, b, dim);
+  const std::size_t stride = 2 * std::size_t(dim), n = (a.size() + b.size()) / stride;
+  if (n == 0)
+    return c;
+  const double cap = std::ceil(2.0 * std::pow(double(n), 1.0 / std::max(1, dim - 1)));
+  std::vector<double> extent;
+  extent.reserve(n);
+  std::int64_t total = 1;
+  for (int k = 0; k < dim; ++k) {
+    if (k == c.axis)
+      continue;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    extent.clear();
+    for (auto s : {a, b})
+      for (std::size_t i = 0; i < s.size() / stride; ++i) {
+        const double l = s[stride * i + std::size_t(k)], h = s[stride * i + std::size_t(dim + k)];
+        lo = std::min(lo, l), hi = std::max(hi, h);
+        extent.push_back(h - l);
+      }
+    std::nth_element(extent.begin(), extent.begin() + std::ptrdiff_t(n / 2), extent.end());
+    const double range = hi - lo;
+    double size = std::max(extent[n / 2], range / cap);
+    std::int64_t count = 1;
+    if (size > 0.0)
+      count = std::int64_t(std::min(cap, std::floor(range / size) + 1.0));
+    else
+      size = 1.0; // all boxes are flat at one coordinate along k: one cell
+    c.sec.push_back(k);
+    c.origin.push_back(lo);
+    c.size.push_back(size);
+    c.count.push_back(count);
+    c.stride.push_back(total);
+    total *= count;
+  }
+  return c;
+}
+
+/// One registration of a box in a cell, sorted by (cell, lower bound along the sweep axis).
+struct Entry {
+  std::int64_t key;
+  double lo;
+  std::int32_t id;
+  bool operator<(const Entry& o) const {
+    return key < o.key or (key == o.key and (lo < o.lo or (lo == o.lo and id < o.id)));
+  }
+};
+
+/// @brief Register every box in each cell its secondary extent covers, sorted by (cell, lower
+/// bound along the sweep axis, index).
+///
+/// Counting sort by cell (linear; a comparison sort of the whole list was slow on the
+/// patterned, nearly sorted input of a lattice), then a sort by lower bound within each cell.
+std::vector<Entry> entries(const std::vector<double>& boxes, const Cells& c) {
+  const std::size_t stride = 2 * std::size_t(c.dim), m = c.sec.size(), n = boxes.size() / stride;
+  std::size_t ncells = 1;
+  for (const auto k : c.count)
+    ncells *= std::size_t(k);
+  std::vector<std::int64_t> first(m), last(m), idx(m);
+  // Visit every (cell key, box) registration; f(key, box).
+  const auto for_each_cell = [&](auto&& f) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const double* bx = boxes.data() + stride * i;
+      for (std::size_t s = 0; s < m; ++s) {
+        first[s] = idx[s] = c.index(s, bx[c.sec[s]]);
+        last[s] = c.index(s, bx[c.dim + c.sec[s]]);
+      }
+      while (true) { // odometer over the covered block of cells
+        std::int64_t key = 0;
+        for (std::size_t s = 0; s < m; ++s)
+          key += c.stride[s] * idx[s];
+        f(std::size_t(key), i);
+        std::size_t s = 0;
+        for (; s < m; ++s) {
+          if (++idx[s] <= last[s])
+            break;
+          idx[s] = first[s];
+        }
+        if (s == m)
+          break;
+      }
+    }
+  };
+  std::vector<std::size_t> offset(ncells + 1, 0);
+  for_each_cell([&](std::size_t key, std::size_t) { ++offset[key + 1]; });
+  for (std::size_t k = 0; k < ncells; ++k)
+    offset[k + 1] += offset[k];
+  std::vector<Entry> out(offset[ncells]);
+  std::vector<std::size_t> pos(offset.begin(), offset.end() - 1);
+  for_each_cell([&](std::size_t key, std::size_t i) {
+    out[pos[key]++] = {std::int64_t(key), boxes[stride * i + std::size_t(c.axis)], std::int32_t(i)};
   });
-  return order;
+  for (std::size_t k = 0; k < ncells; ++k)
+    std::sort(out.begin() + std::ptrdiff_t(offset[k]), out.begin() + std::ptrdiff_t(offset[k + 1]));
+  return out;
+}
+
+/// @brief End of the run of entries with the same cell key as e[p].
+std::size_t run_end(const std::vector<Entry>& e, std::size_t p) {
+  std::size_t q = p;
+  while (q < e.size() and e[q].key == e[p].key)
+    ++q;
+  return q;
 }
 
 std::vector<std::int32_t> flatten_sorted(std::vector<std::array<std::int32_t, 2>>& pairs) {
@@ -123,23 +244,24 @@ std::vector<std::int32_t> candidate_pairs(std::span<const double> boxes, int dim
   check_boxes(boxes, dim, "boxes");
   check_inflate(inflate);
   const auto ib = inflated(boxes, dim, inflate);
-  const int axis = sweep_axis(boxes, {}, dim);
-  const auto order = sorted_by_lo(ib, dim, axis);
-  const std::size_t stride = 2 * std::size_t(dim), n = order.size();
-  const auto box = [&](std::int32_t i) { return ib.data() + stride * std::size_t(i); };
+  const Cells cells = make_cells(ib, {}, dim);
+  const auto e = entries(ib, cells);
+  const std::size_t stride = 2 * std::size_t(dim);
+  const auto box = [&](std::size_t p) { return ib.data() + stride * std::size_t(e[p].id); };
 
-  // For an overlapping pair, the box that comes first in `order` has the smaller lower bound,
-  // and the other's lower bound lies within its interval: scanning forward while the lower
-  // bounds stay <= hi finds it, and visits only pairs that overlap along the sweep axis.
+  // In a cell, of an overlapping pair the box that comes first has the smaller lower bound and
+  // the other's lower bound lies within its interval: scanning forward while the lower bounds
+  // stay <= hi finds it, visiting only the pairs that overlap along the sweep axis.
   std::vector<std::array<std::int32_t, 2>> pairs;
-  for (std::size_t p = 0; p < n; ++p) {
-    const std::int32_t i = order[p];
-    const double hi = box(i)[dim + axis];
-    for (std::size_t q = p + 1; q < n and box(order[q])[axis] <= hi; ++q) {
-      const std::int32_t j = order[q];
-      if (overlap(box(i), box(j), dim))
-        pairs.push_back({std::min(i, j), std::max(i, j)});
+  for (std::size_t r = 0; r < e.size();) {
+    const std::size_t end = run_end(e, r);
+    for (std::size_t p = r; p < end; ++p) {
+      const double hi = box(p)[dim + cells.axis];
+      for (std::size_t q = p + 1; q < end and e[q].lo <= hi; ++q)
+        if (overlap(box(p), box(q), dim) and cells.owner(box(p), box(q)) == e[p].key)
+          pairs.push_back({std::min(e[p].id, e[q].id), std::max(e[p].id, e[q].id)});
     }
+    r = end;
   }
   return flatten_sorted(pairs);
 }
@@ -151,33 +273,50 @@ std::vector<std::int32_t> candidate_pairs_between(std::span<const double> boxes_
   check_boxes(boxes_b, dim, "boxes_b");
   check_inflate(inflate);
   const auto ia = inflated(boxes_a, dim, inflate), ib = inflated(boxes_b, dim, inflate);
-  const int axis = sweep_axis(boxes_a, boxes_b, dim);
-  const auto oa = sorted_by_lo(ia, dim, axis), ob = sorted_by_lo(ib, dim, axis);
+  const Cells cells = make_cells(ia, ib, dim);
+  const auto ea = entries(ia, cells), eb = entries(ib, cells);
   const std::size_t stride = 2 * std::size_t(dim);
+  const int ax = cells.axis;
   const auto box = [&](const std::vector<double>& v, std::int32_t i) {
     return v.data() + stride * std::size_t(i);
   };
 
-  // An overlapping pair has lo_a <= lo_b <= hi_a or lo_b < lo_a <= hi_b: two sweeps, each
-  // from a monotone start pointer, cover the two cases exactly once.
   std::vector<std::array<std::int32_t, 2>> pairs;
-  std::size_t start = 0;
-  for (const std::int32_t i : oa) {
-    const double lo = box(ia, i)[axis], hi = box(ia, i)[dim + axis];
-    while (start < ob.size() and box(ib, ob[start])[axis] < lo)
-      ++start;
-    for (std::size_t q = start; q < ob.size() and box(ib, ob[q])[axis] <= hi; ++q)
-      if (overlap(box(ia, i), box(ib, ob[q]), dim))
-        pairs.push_back({i, ob[q]});
-  }
-  start = 0;
-  for (const std::int32_t j : ob) {
-    const double lo = box(ib, j)[axis], hi = box(ib, j)[dim + axis];
-    while (start < oa.size() and box(ia, oa[start])[axis] <= lo)
-      ++start;
-    for (std::size_t p = start; p < oa.size() and box(ia, oa[p])[axis] <= hi; ++p)
-      if (overlap(box(ia, oa[p]), box(ib, j), dim))
-        pairs.push_back({oa[p], j});
+  const auto report = [&](std::int32_t i, std::int32_t j, std::int64_t key) {
+    if (overlap(box(ia, i), box(ib, j), dim) and cells.owner(box(ia, i), box(ib, j)) == key)
+      pairs.push_back({i, j});
+  };
+  std::size_t pa = 0, pb = 0;
+  while (pa < ea.size() and pb < eb.size()) {
+    if (ea[pa].key < eb[pb].key) {
+      pa = run_end(ea, pa);
+      continue;
+    }
+    if (eb[pb].key < ea[pa].key) {
+      pb = run_end(eb, pb);
+      continue;
+    }
+    const std::int64_t key = ea[pa].key;
+    const std::size_t enda = run_end(ea, pa), endb = run_end(eb, pb);
+    // An overlapping pair has lo_a <= lo_b <= hi_a or lo_b < lo_a <= hi_b: two sweeps, each
+    // from a monotone start pointer, cover the two cases exactly once.
+    std::size_t start = pb;
+    for (std::size_t p = pa; p < enda; ++p) {
+      const double hi = box(ia, ea[p].id)[dim + ax];
+      while (start < endb and eb[start].lo < ea[p].lo)
+        ++start;
+      for (std::size_t q = start; q < endb and eb[q].lo <= hi; ++q)
+        report(ea[p].id, eb[q].id, key);
+    }
+    start = pa;
+    for (std::size_t q = pb; q < endb; ++q) {
+      const double hi = box(ib, eb[q].id)[dim + ax];
+      while (start < enda and ea[start].lo <= eb[q].lo)
+        ++start;
+      for (std::size_t p = start; p < enda and ea[p].lo <= hi; ++p)
+        report(ea[p].id, eb[q].id, key);
+    }
+    pa = enda, pb = endb;
   }
   return flatten_sorted(pairs);
 }

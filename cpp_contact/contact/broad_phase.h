@@ -4,9 +4,13 @@
 // Broad phase of the multi-body contact search: which pairs of bodies (or body and rigid
 // obstacle) can touch, from axis-aligned bounding boxes. The narrow phase (contact surface,
 // eqs 21-24) then runs only on the candidate pairs, so its cost grows with the bodies and the
-// touching pairs, not with all n (n - 1) / 2 pairs. Sort-and-sweep along one axis: O(n log n)
-// for the sort plus the pairs whose intervals overlap on that axis, which for a packing of
-// grains of bounded aspect ratio is O(n). Any dimension d >= 1 (chosen at run time).
+// touching pairs, not with all n (n - 1) / 2 pairs. Sort-and-sweep along the axis of largest
+// spread of the box centres, run separately in each cell of a uniform grid over the other axes
+// (cells about one median box wide): a single global sweep would visit every pair overlapping
+// along the sweep axis, O(n^1.5) for grains filling a square, whereas per cell each box meets
+// O(1) intervals. Cost O(n log n + pairs) for boxes of comparable size; a box much larger than
+// the median (a rigid plate) is registered in every cell it covers. Any dimension d >= 1
+// (chosen at run time; d = 1 is a plain sweep).
 //
 // Box layout (both entry points): flattened (n, 2, d), body b is
 // [lo_0, ..., lo_{d-1}, hi_0, ..., hi_{d-1}] at offset 2 d b.
@@ -20,8 +24,8 @@ namespace contact {
 /// @brief Candidate pairs i < j of one set of boxes whose inflated boxes overlap.
 ///
 /// Every box grows by `inflate` on every side (so boxes separated by up to 2 inflate along
-/// every axis are reported); closed boxes, i.e. touching counts. Sort-and-sweep along the axis
-/// of largest spread of the box centres.
+/// every axis are reported); closed boxes, i.e. touching counts. A pair met in several cells
+/// is reported once, by the cell holding the lower corner of the boxes' intersection.
 /// @param[in] boxes Flattened (n, 2, dim): lo then hi of each box
 /// @param[in] dim Spatial dimension (>= 1)
 /// @param[in] inflate Margin added on every side of every box (>= 0)
@@ -33,8 +37,9 @@ std::vector<std::int32_t> candidate_pairs(std::span<const double> boxes, int dim
 
 /// @brief Candidate pairs (a, b) between two sets (e.g. bodies and rigid obstacles).
 ///
-/// Same inflation and overlap rule as candidate_pairs; both sets are swept together along the
-/// axis of largest spread of all centres.
+/// Same inflation and overlap rule as candidate_pairs; one grid and sweep axis for both sets
+/// (from all centres), and in each cell a merged sweep of the two sorted lists, so that pairs
+/// within one set are never visited.
 /// @param[in] boxes_a Flattened (n_a, 2, dim) boxes of the first set
 /// @param[in] boxes_b Flattened (n_b, 2, dim) boxes of the second set
 /// @param[in] dim Spatial dimension (>= 1)

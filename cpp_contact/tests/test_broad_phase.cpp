@@ -57,8 +57,9 @@ std::vector<double> lattice_boxes(int m, int dim) {
 void expect_sorted_pairs(const std::vector<std::int32_t>& p, bool ordered) {
   ASSERT_EQ(p.size() % 2, 0u);
   for (std::size_t q = 0; q < p.size() / 2; ++q) {
-    if (ordered)
+    if (ordered) {
       EXPECT_LT(p[2 * q], p[2 * q + 1]);
+    }
     if (q > 0) {
       const bool lex =
           p[2 * q - 2] < p[2 * q] or (p[2 * q - 2] == p[2 * q] and p[2 * q - 1] < p[2 * q + 1]);
@@ -93,10 +94,13 @@ TEST(BroadPhase, BetweenMatchesBruteForce) {
         for (double inflate : {0.0, 0.2}) {
           const auto a = random_boxes(na, dim, unsigned(na + 3 * nb + dim));
           auto b = random_boxes(nb, dim, unsigned(11 * na + nb + 5 * dim));
-          // Share some lower bounds exactly to exercise the tie rule (lo_a == lo_b).
+          // Share some lower bounds exactly (same side) to exercise the tie rule lo_a == lo_b.
           for (std::size_t j = 0; j < std::min(na, nb); j += 2)
-            for (int k = 0; k < dim; ++k)
+            for (int k = 0; k < dim; ++k) {
+              const double side = b[2 * dim * j + dim + k] - b[2 * dim * j + k];
               b[2 * dim * j + k] = a[2 * dim * j + k];
+              b[2 * dim * j + dim + k] = a[2 * dim * j + k] + side;
+            }
           const auto fast = candidate_pairs_between(a, b, dim, inflate);
           const auto ref = candidate_pairs_between_brute_force(a, b, dim, inflate);
           ASSERT_EQ(fast, ref) << "dim " << dim << " na " << na << " nb " << nb;
