@@ -7,6 +7,7 @@ is `ufl.derivative`. Linear laws (and the ghost penalty) form the matrix K assem
 that their residual is K u; nonlinear laws are assembled at every Newton iteration.
 """
 
+import numpy as np
 import ufl
 from dolfinx import fem
 from petsc4py import PETSc
@@ -20,7 +21,8 @@ class BulkForms:
     laws: {body tag: Law or (E, nu)}; tractions: `boundary.Traction`s; loads: `BodyForce` /
     `Load`s; integration: a `cut.CutIntegration` on cut scenes (None: body-fitted);
     quadrature_degree: FFCx degree on body-fitted cells and interior cut cells (None: FFCx's
-    estimate for linear laws, 2 p for nonlinear ones)."""
+    estimate for linear laws, 2 p for nonlinear ones); rigid_mode_stiffness: alpha of a spring
+    alpha E / L^2 on every body's displacement (0: none; see __init__)."""
 
     def __init__(
         self,
@@ -33,6 +35,7 @@ class BulkForms:
         integration=None,
         ghost_penalty=0.0,
         quadrature_degree=None,
+        rigid_mode_stiffness=0.0,
     ):
         self.u, self.V, self.scene = u, u.function_space, scene
         mesh = scene.mesh
@@ -65,6 +68,15 @@ class BulkForms:
             if not law.linear
         ]
         a_lin = [ufl.derivative(sum(lin[1:], lin[0]), u, du)] if lin else []
+        if rigid_mode_stiffness > 0:
+            # alpha E / L^2 int u . v on each body (L: its bbox diagonal): a floor under the
+            # rigid modes of bodies held only by contact (a grain before its contacts close),
+            # relative size alpha on the body's elastic stiffness
+            for tag, law in self.laws.items():
+                body = next(b for b in scene.bodies if b.tag == tag)
+                L2 = float(np.sum(np.ptp(np.asarray(body.bbox, float), axis=0) ** 2))
+                c = rigid_mode_stiffness * law.modulus / L2
+                a_lin.append(c * ufl.inner(du, v) * measure(tag))
         if integration is not None and ghost_penalty > 0:
             pm = fem.Function(fem.FunctionSpace(mesh, ("DG", 0)), name="p_modulus")
             cell_dof = pm.function_space.dofmap.list.array

@@ -204,9 +204,12 @@ def pair_geometry(
     max_outside=None,
     projection="auto",
     obstacle=None,
+    lattice_origin=None,
 ):
     """Contact quadrature of `pair` (indices into scene.bodies), or of body pair[0] and the
     rigid `obstacle` (pair[1] ignored): side j then has no dofs (nodes_j = 0).
+    lattice_origin: None (the pair grid starts at the search box's corner) or a point: the pair
+    grid's nodes then lie on origin + (h / grid_refine) Z^2, the same lattice for every pair.
 
     band: largest initial gap covered by Gamma_c (eq 22 uses eps = band / 2), a length.
     grid_refine: level-set grid cells per mesh size h_contact.
@@ -224,7 +227,12 @@ def pair_geometry(
     box = search_box(bi, bj, band + 4 * dx)
     if box is None:
         return None
-    n = np.maximum(np.ceil((box[1] - box[0]) / dx).astype(int), 3)
+    if lattice_origin is not None:
+        # nodes on the lattice origin + dx Z^2: the pair grids of mirror-image pairs are
+        # mirror images (symmetric assemblies stay symmetric), whatever the boxes
+        o = np.asarray(lattice_origin, float)
+        box[0] = o + np.floor((box[0] - o) / dx + 1e-9) * dx
+    n = np.maximum(np.ceil((box[1] - box[0]) / dx - 1e-9).astype(int), 3)
     hi = box[0] + n * dx  # keep the spacing exactly dx
     # the boxes' overlap before the band's inflation (touching boxes give a flat one)
     core = np.array(

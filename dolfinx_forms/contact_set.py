@@ -25,13 +25,24 @@ class ContactSet:
     prescribed motion at load level lam is set by `set_load`."""
 
     def __init__(
-        self, V, scene, eps_n, eps_t, mu, band, grid_refine=4, num_gauss=2, rank=0, obstacles=()
+        self,
+        V,
+        scene,
+        eps_n,
+        eps_t,
+        mu,
+        band,
+        grid_refine=4,
+        num_gauss=2,
+        rank=0,
+        obstacles=(),
+        lattice_origin=None,
     ):
         self.eps_n, self.eps_t, self.mu = float(eps_n), float(eps_t), float(mu)
         self.pairs = []
         self.obstacles = list(obstacles)
         if V.mesh.comm.rank == rank:
-            kw = dict(grid_refine=grid_refine, num_gauss=num_gauss)
+            kw = dict(grid_refine=grid_refine, num_gauss=num_gauss, lattice_origin=lattice_origin)
             candidates = [(pair, None) for pair in scene.pairs] + [
                 ((i, -1), ob)
                 for ob in self.obstacles
@@ -94,18 +105,20 @@ class ContactSet:
             out[g.obstacle.name] = (F0 + F, M0 + M)
         return out
 
-    def _evaluate(self, k, u, b=None, A=None, fd=False, fd_step=1e-9, mu=None):
+    def _evaluate(self, k, u, b=None, A=None, fd=False, fd_step=1e-9, mu=None, closed_gap=0.0):
         mu = self.mu if mu is None else mu
         gtp = self.history[k].committed if mu > 0 else _NONE
         return _cpp.assemble_contact(
-            self.pairs[k].quadrature, self.eps_n, self.eps_t, mu, u, gtp, b, A, fd, fd_step
+            self.pairs[k].quadrature, self.eps_n, self.eps_t, mu, u, gtp, b, A, fd, fd_step,
+            closed_gap,
         )
 
-    def assemble(self, u, b, A=None, fd=False, fd_step=1e-9):
+    def assemble(self, u, b, A=None, fd=False, fd_step=1e-9, closed_gap=0.0):
         """Add the contact residual of displacement array u to the array b (local, with
-        ghosts) and, with A, the consistent tangent; keep the trial states."""
+        ghosts) and, with A, the consistent tangent; keep the trial states. closed_gap: open
+        points with g_n < closed_gap lend a closed point's tangent (the predictor, kernel)."""
         for k in range(len(self.pairs)):
-            s = self._evaluate(k, u, b, A, fd, fd_step)
+            s = self._evaluate(k, u, b, A, fd, fd_step, closed_gap=closed_gap)
             self.last[k] = s
             if self.mu > 0:
                 self.history[k].trial = s["gtp_trial"]

@@ -148,7 +148,8 @@ class ImplicitMPM:
     def _step(self):
         t0 = time.perf_counter()
         with self.phase("mesh"):
-            scene = self.build_scene(dict(self.levelsets))
+            pairs = self.candidate_pairs()
+            scene = self.build_scene(dict(self.levelsets), pairs)
         sigma0 = None
         if self.points is not None:
             with self.phase("mls"):
@@ -162,6 +163,8 @@ class ImplicitMPM:
                 Load(lambda v, measure: -ufl.inner(S, ufl.grad(v)) * measure(None, degree=mp.DEGREE),
                      scale=lambda lam: 1.0)
             )
+        kw = dict(self.problem_kw)
+        kw.setdefault("pair_grid_origin", (self.xlines[0], self.ylines[0]))
         problem = ContactProblem(
             scene,
             self.laws,
@@ -170,7 +173,7 @@ class ImplicitMPM:
             obstacles=self.obstacles,
             timer=self.timer,
             log=self.log,
-            **self.problem_kw,
+            **kw,
         )
         if self.points is None:
             self.points = {b.tag: mp.seed(scene, problem.integration, b.tag) for b in self.bodies}
@@ -180,6 +183,7 @@ class ImplicitMPM:
         problem.solve(1, 1.0, label=f"MPM step {self.step_count + 1}")
         # ---- converged: from here on the state changes
         record = self._contact_record(problem, scene, keys)
+        record["support_forces"] = self._support_forces(problem, scene)
         with self.phase("points"):
             outside = 0
             moved = []
@@ -214,6 +218,30 @@ class ImplicitMPM:
         return record
 
     # ------------------------------------------------------------------ parts
+    def body_boxes(self):
+        """(n, 2, 2) bounding box of each body's material: the grid nodes with phi <= 0, grown by
+        one spacing (the zero contour lies within it)."""
+        X, Y = np.meshgrid(self.xlines, self.ylines)
+        out = []
+        for b in self.bodies:
+            inside = self.levelsets[b.tag].values <= 0
+            if not inside.any():
+                raise RuntimeError(f"body {b.name!r}: its level set has no node inside")
+            lo = np.array([X[inside].min(), Y[inside].min()]) - self.h
+            hi = np.array([X[inside].max(), Y[inside].max()]) + self.h
+            out.append([lo, hi])
+        return np.array(out)
+
+    def candidate_pairs(self):
+        """Body pairs whose boxes, inflated by the contact band (and the level-set grid of the
+        pair search), overlap: the broad phase (`_cpp.candidate_pairs`, sort and sweep), so the
+        narrow phase (Gamma_c, eqs 21-24) runs on touching pairs only."""
+        if len(self.bodies) < 2:
+            return []
+        band = self.problem_kw.get("band") or 2 * self.h
+        pairs = _cpp.candidate_pairs(self.body_boxes().reshape(len(self.bodies), 4), 0.5 * band)
+        return [tuple(int(v) for v in p) for p in np.asarray(pairs).reshape(-1, 2)]
+
     def _project(self, scene):
         """MLS projection of each body's point stress to the Gauss points (degree mp.DEGREE) of
         its cells: a `Quadrature` vector function [s_xx, s_yy, s_xy]."""
@@ -236,6 +264,28 @@ class ImplicitMPM:
         if widened:
             self.log(f"MLS: {widened} integration points needed a wider support (reported)")
         return sigma0, {"widened": widened}
+
+    def _support_forces(self, problem, scene):
+        """{body: [fx, fy]} exerted on each body by its Dirichlet conditions: the residual
+        (internal - external + contact forces) summed over the body's prescribed dofs."""
+        out = {}
+        if not problem.dirichlet:
+            return {b.name: [0.0, 0.0] for b in self.bodies}
+        problem.residual(1.0, zero_bc=False)
+        R = problem.R.array.reshape(-1, 2)
+        owned = problem.n_owned
+        bc = np.zeros(owned, bool)
+        bc[problem.bc_owned] = True
+        cell_dofs = problem.V.dofmap.list.array.reshape(-1, 4)
+        for b in self.bodies:
+            nodes = np.unique(cell_dofs[scene.cell_tags.find(b.tag)])
+            nodes = nodes[2 * nodes + 1 < owned]
+            f = np.zeros(2)
+            for c in range(2):
+                sel = bc[2 * nodes + c]
+                f[c] = R[nodes[sel], c].sum()
+            out[b.name] = allreduce_array(self.comm, f, MPI.SUM).tolist()
+        return out
 
     def _transfer_friction(self, problem, keys):
         """Each new contact point starts from the elastic tangential gap e_t = g_t - g_t^p of
@@ -272,8 +322,11 @@ class ImplicitMPM:
             order = np.argsort(g.points[:, 0])
             xl, xr = zone_ends(g.points[order, 0], active[order], s["g_n"][order])
             wa = w[active]
+            f = -(s["tau_n"][:, None] * g.normals + s["tau_t"][:, None] * g.tangents) * w[:, None]
             pairs.append(
                 dict(
+                    fx=float(f[:, 0].sum()),  # resultant on body j (the obstacle) from body i
+                    fy=float(f[:, 1].sum()),
                     body_i=keys[k][0],
                     body_j=keys[k][1],
                     x=float(np.average(g.points[active, 0], weights=wa)) if active.any() else 0.0,

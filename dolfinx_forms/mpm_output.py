@@ -244,3 +244,41 @@ def run_steps(
             print(summary(run) if callable(summary) else summary.format(**metrics))
         print(f"results in {Path(params['out']).resolve()}")
     return 0
+
+
+def plot_force_chains(sim, record, path, title="force chains"):
+    """The force network of one step: segments from the centroids of the two bodies of every
+    pair with a normal force to the centre of its contact zone (width by normal force; a wall's
+    or obstacle's side is left out when its centroid lies far from the contact), over the mean
+    stress (s_xx + s_yy) / 2 at the material points (clipped at its 2nd percentile)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    centroid, radius = {}, {}
+    for b in sim.bodies:
+        p = sim.points[b.tag]
+        centroid[b.name] = np.average(p.x, axis=0, weights=p.vol)
+        radius[b.name] = np.sqrt(p.vol.sum() / np.pi)
+    fig, ax = plt.subplots(figsize=(6, 6))
+    mean = [0.5 * (p.stress[:, 0] + p.stress[:, 1]) for p in sim.points.values()]
+    lo = min(np.percentile(np.concatenate(mean), 2), -1e-300)
+    for p, m in zip(sim.points.values(), mean):
+        sc = ax.scatter(p.x[:, 0], p.x[:, 1], c=m, s=0.3, cmap="Greys_r", vmin=lo, vmax=0)
+    fmax = max([q["normal_force"] for q in record["pairs"]] + [1e-300])
+    for q in record["pairs"]:
+        if q["normal_force"] <= 0:
+            continue
+        c = np.array([q["x"], q["y"]])
+        lw = 0.5 + 5 * q["normal_force"] / fmax
+        # centroid -> contact for grain-like sides (a wall's centroid can be far away)
+        for name in (q["body_i"], q["body_j"]):
+            if name in centroid and np.linalg.norm(centroid[name] - c) < 1.5 * radius[name]:
+                a = centroid[name]
+                ax.plot([a[0], c[0]], [a[1], c[1]], "-", color="tab:red", lw=lw)
+    fig.colorbar(sc, ax=ax, label="mean stress (s_xx + s_yy)/2", shrink=0.8)
+    ax.set(aspect="equal", title=f"{title}, step {record['step']}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

@@ -46,7 +46,7 @@ def newton(problem, lam):
     residuals, seen = [], {}
     r0 = None
     for it in range(opts.max_iterations + 1):
-        r = problem.residual(lam, with_tangent=True)
+        r = problem.residual(lam, with_tangent=True, predictor=it == 0)
         residuals.append(r)
         if not np.isfinite(r):
             return (

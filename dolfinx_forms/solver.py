@@ -39,6 +39,13 @@ class ContactProblem:
     data (meshes.cut) integrates over the inside part of cut cells (`cut.CutIntegration`,
     degree `cut_degree`) with ghost penalty `ghost_penalty` (0: none). obstacles: rigid
     `obstacles.RigidObstacle`s (no dofs) whose step motion is ramped with lam.
+    rigid_mode_stiffness: alpha of a spring alpha E / L^2 on every body's displacement, for
+    bodies held by contact alone (free grains); it changes the answer by ~alpha (0: none).
+    predictor_gap: in the first Newton iteration of a step, open contact points with a gap
+    below it add a closed point's tangent (no force), so bodies whose contacts touch but are
+    not closed yet are held (a length; 0: exact tangent throughout; the answer is unchanged).
+    pair_grid_origin: None, or a point through which every pair's level-set grid passes
+    (`contact.pair_geometry`'s lattice_origin: symmetric scenes stay symmetric).
     """
 
     def __init__(
@@ -63,6 +70,9 @@ class ContactProblem:
         quadrature_degree=None,
         cut_degree=4,
         obstacles=(),
+        rigid_mode_stiffness=0.0,
+        predictor_gap=0.0,
+        pair_grid_origin=None,
         log=print,
     ):
         self.scene, self.mesh = scene, scene.mesh
@@ -70,6 +80,7 @@ class ContactProblem:
         self.newton = newton or NewtonOptions()
         self.timer = timer
         self.log = log if self.comm.rank == 0 else (lambda *a, **k: None)
+        self.predictor_gap = float(predictor_gap)
         self.laws = {int(t): as_law(m) for t, m in materials.items()}
         self.materials = self.laws
 
@@ -96,6 +107,7 @@ class ContactProblem:
                 integration=self.integration,
                 ghost_penalty=ghost_penalty,
                 quadrature_degree=quadrature_degree,
+                rigid_mode_stiffness=rigid_mode_stiffness,
             )
             self.dirichlet = list(dirichlet)
             self.bc_dofs = [dirichlet_dofs(self.V, scene, d) for d in self.dirichlet]
@@ -124,6 +136,7 @@ class ContactProblem:
                 num_gauss,
                 contact_rank,
                 obstacles,
+                pair_grid_origin,
             )
         self.pairs = self.contact.pairs
 
@@ -186,8 +199,9 @@ class ContactProblem:
         for d, dofs in zip(self.dirichlet, self.bc_dofs):
             x[dofs] = d.at(lam)
 
-    def residual(self, lam, with_tangent=False, zero_bc=True):
-        """R = F_bulk(u) - f(lam) + r_c(u) (owned part); with_tangent also fills self.J."""
+    def residual(self, lam, with_tangent=False, zero_bc=True, predictor=False):
+        """R = F_bulk(u) - f(lam) + r_c(u) (owned part); with_tangent also fills self.J (with
+        `predictor`, the first iteration's tangent: see predictor_gap)."""
         with self.phase("assembly"):
             self.u.x.scatter_forward()
             self.K.mult(self.u.vector, self.Ku)
@@ -206,6 +220,7 @@ class ContactProblem:
                 self.J if with_tangent else None,
                 self.newton.fd_tangent,
                 self.newton.fd_step,
+                self.predictor_gap if predictor else 0.0,
             )
             self._rc.x.scatter_reverse(la.ScatterMode.add)
         with self.phase("assembly"):

@@ -23,19 +23,20 @@ def uniform_lines(lo, hi, h):
 
 
 def grid_scene(comm, xlines, ylines, bodies, pairs=(), boundary_markers=None, contact_box=None):
-    """build_scene(levelsets {tag: _cpp.LevelSet}) -> Scene for `bodies` [(name, tag)] on the
-    grid; pairs: body-body contact pairs (indices into bodies); boundary_markers: as in
+    """build_scene(levelsets {tag: _cpp.LevelSet}, pairs=None) -> Scene for `bodies`
+    [(name, tag)] on the grid; pairs: body-body contact pairs (indices into bodies; the
+    simulation passes its broad phase's each step, else these); boundary_markers: as in
     meshes.cut.cut_scene (default none); contact_box: the cells kept on rank 0 where contact is
     computed ((2, 2) or (k, 2, 2); None: from the pairs; required with obstacles in parallel)."""
     xlines, ylines = np.asarray(xlines, float), np.asarray(ylines, float)
     window = np.array([[xlines[0], ylines[0]], [xlines[-1], ylines[-1]]])
     h = float(max(np.diff(xlines).max(), np.diff(ylines).max()))
+    fixed = list(pairs)
 
-    def build(levelsets):
+    def build(levelsets, pairs=None):
         cbodies = [CutBody(name, tag, window, levelsets[tag]) for name, tag in bodies]
-        return cut_scene(
-            comm, xlines, ylines, cbodies, boundary_markers or {}, list(pairs), h, contact_box
-        )
+        use = fixed if pairs is None else [tuple(p) for p in pairs]
+        return cut_scene(comm, xlines, ylines, cbodies, boundary_markers or {}, use, h, contact_box)
 
     return build
 
@@ -69,3 +70,72 @@ def brazilian_disc(comm, R=10.0, h=0.2, step_displacement=0.02, steps=50, margin
     )
     build = grid_scene(comm, xl, yl, [("disc", 1)], contact_box=box)
     return (xl, yl), ("disc", 1, df.Circle((0.0, 0.0), R)), [top, bottom], build
+
+
+def disc_column(comm, n=5, R=10.0, h=0.5, step_displacement=0.05, steps=20, margin=None):
+    """n identical discs of radius R stacked on x = 0 (centres 2 R k, k = 0..n-1, touching)
+    between a fixed lower platen (y < -R) and an upper one (y > (2 n - 1) R) moved down by
+    step_displacement per step. Returns (grid lines, [(name, tag, shape)], obstacles,
+    build_scene); body-body pairs come from the simulation's broad phase."""
+    margin = 3 * h + step_displacement * steps if margin is None else margin
+    top_y = (2 * n - 1) * R
+    xl = uniform_lines(-R - margin, R + margin, h)
+    yl = uniform_lines(-R - margin, top_y + margin, h)
+    ext = 100 * n * R
+    top = RigidObstacle(
+        "platen_top",
+        half_plane((0.0, top_y), (0.0, -1.0), ext),
+        bbox=[[-2 * R, top_y], [2 * R, top_y + R]],
+        center=(0.0, top_y),
+        translation=(0.0, -step_displacement),
+    )
+    bottom = RigidObstacle(
+        "platen_bottom",
+        half_plane((0.0, -R), (0.0, 1.0), ext),
+        bbox=[[-2 * R, -2 * R], [2 * R, -R]],
+        center=(0.0, -R),
+    )
+    bodies = [(f"disc{k}", k + 1, df.Circle((0.0, 2 * R * k), R)) for k in range(n)]
+    build = grid_scene(comm, xl, yl, [(b[0], b[1]) for b in bodies], contact_box=False)
+    return (xl, yl), bodies, [top, bottom], build
+
+
+def nine_discs(comm, R=1.7, plate=(1.0, 9.8), h=0.1, overlap=1e-3, margin=None):
+    """Nine discs of radius R on a 3 x 3 lattice of spacing 2 R - overlap, confined by four
+    deformable plates of thickness plate[0] and length plate[1] whose inner faces overlap the
+    outer discs by `overlap` (paper 5.2.1: "the discs are compressed [by the fixed plates]
+    since there are initial gaps": touching bodies whose contacts are all open at the first
+    Newton iteration leave the discs free, so every contact starts closed). The plates' outer
+    faces lie on grid lines (Dirichlet conditions on grid nodes there: `outer_faces`); the
+    grid is symmetric under the square's symmetry group. Returns (grid lines,
+    [(name, tag, shape)], build_scene, outer_faces {plate name: (axis, coordinate)})."""
+    t, length = plate
+    pitch = 2 * R - overlap
+    inner = pitch + R - overlap
+    R_grid = 3 * R  # the outer faces: 3 R + t, a grid line
+    k = int(round((R_grid + t) / h))
+    if abs(k * h - (R_grid + t)) > 1e-9 * (R_grid + t):
+        raise ValueError(
+            f"nine_discs: h must divide 3 R + thickness = {R_grid + t:g} (the plates' outer "
+            f"faces lie on grid lines), got h = {h:g}"
+        )
+    margin = 3 * h if margin is None else margin
+    n = k + int(np.ceil(margin / h))
+    lines = h * np.arange(-n, n + 1, dtype=float)
+    outer = lines[n + k]  # the grid line at 3 R + t, exactly
+    bodies = [
+        (f"disc{3 * j + i}", 3 * j + i + 1, df.Circle((pitch * (i - 1), pitch * (j - 1)), R))
+        for j in range(3)
+        for i in range(3)
+    ]
+    half = 0.5 * length
+    plates = {
+        "plate_left": (df.Box((-outer, -half), (-inner, half)), (0, -outer)),
+        "plate_right": (df.Box((inner, -half), (outer, half)), (0, outer)),
+        "plate_bottom": (df.Box((-half, -outer), (half, -inner)), (1, -outer)),
+        "plate_top": (df.Box((-half, inner), (half, outer)), (1, outer)),
+    }
+    for m, (name, (shape, _)) in enumerate(plates.items()):
+        bodies.append((name, 10 + m, shape))
+    build = grid_scene(comm, lines, lines, [(b[0], b[1]) for b in bodies], contact_box=False)
+    return (lines, lines), bodies, build, {name: face for name, (_, face) in plates.items()}

@@ -174,3 +174,29 @@ def test_grid_levelset_obstacle_matches_its_polygon():
     a = exact.closest_points(x, 0.01, exact.levelset(pair_grid))["points"]
     b = onGrid.closest_points(x, 0.01, onGrid.levelset(pair_grid))["points"]
     assert np.max(np.linalg.norm(a - b, axis=1)) < 1e-3
+
+
+def test_disc_column_carries_the_load_through_every_contact():
+    """Three discs stacked between rigid platens, frictionless, found by the broad phase: every
+    contact carries the same force (1e-6 relative; vertical resultants of the contact
+    tractions) and every disc is in equilibrium (its contact resultant below 1e-8 of the
+    force)."""
+    from meshes.mpm import disc_column
+
+    grid, bodies, platens, build = disc_column(COMM, 3, 10.0, 0.5, 0.1, 3)
+    sim = ImplicitMPM(
+        COMM, grid, [MPMBody(n, t, (100e3, 0.3), s) for n, t, s in bodies], build,
+        obstacles=platens, dirichlet=[Dirichlet(lambda x: np.isclose(x[0], 0.0), 0, 0.0)],
+        eps0=0.3, **quiet,
+    )
+    for _ in range(3):
+        rec = sim.step()
+        keys = sorted((p["body_i"], p["body_j"]) for p in rec["pairs"])
+        assert keys == [("disc0", "disc1"), ("disc0", "platen_bottom"), ("disc1", "disc2"),
+                        ("disc2", "platen_top")]
+        F = np.array([abs(p["fy"]) for p in rec["pairs"]])
+        assert np.ptp(F) <= 1e-6 * F.max()
+        for name, f in rec["body_forces"].items():  # contacts + the symmetry line's support
+            s = rec["support_forces"][name]
+            assert np.hypot(f[0] + s[0], f[1] + s[1]) <= 1e-8 * F.max(), name
+    assert rec["obstacles"]["platen_top"]["fy"] == pytest.approx(F.max(), rel=1e-6)

@@ -84,7 +84,7 @@ std::vector<std::int32_t> coupling_dofs(const ContactQuadrature& q) {
 ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPenalty& law,
                                    std::span<const double> u, std::span<const double> gtp_old,
                                    std::span<double> b, const BlockInserter& insert,
-                                   TangentMode mode, double fd_step) {
+                                   TangentMode mode, double fd_step, double closed_gap) {
   q.validate();
   if (!(law.eps_n > 0) or !(law.eps_t > 0) or !(law.mu >= 0) or !std::isfinite(law.mu))
     throw std::invalid_argument("assemble_contact: need eps_n > 0, eps_t > 0, finite mu >= 0");
@@ -139,10 +139,17 @@ ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPena
     point_law(law, s.g_n[p], s.g_t[p], gtp0, s.tau_n[p], s.tau_t[p], gtp, s.state[p], D);
     if (friction)
       s.gtp_trial[p] = gtp;
-    if (s.state[p] == ContactState::open)
-      continue;
+    bool predictor = false;
+    if (s.state[p] == ContactState::open) {
+      // A touching point (0 <= g_n < closed_gap) lends the tangent of a closed, sticking point
+      // (no traction): the predictor of a step whose bodies are held by contacts not yet closed
+      if (!insert or !(s.g_n[p] < closed_gap))
+        continue;
+      predictor = true;
+      D = {1.0 / law.eps_n, 0.0, 0.0, friction ? 1.0 / law.eps_t : 0.0};
+    }
 
-    if (!b.empty()) {
+    if (!b.empty() and !predictor) {
       for (std::size_t a = 0; a < nd; ++a)
         for (std::size_t c = 0; c < 2; ++c)
           b[2 * std::size_t(dofs[a]) + c] +=
@@ -151,7 +158,7 @@ ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPena
     if (!insert)
       continue;
 
-    if (mode == TangentMode::exact) {
+    if (mode == TangentMode::exact or predictor) {
       // K = w B^T D B with B = [Bn; Bt]
       for (std::size_t r = 0; r < ne; ++r) {
         const double dn = w * (Bn[r] * D[0] + Bt[r] * D[2]);

@@ -119,7 +119,7 @@ void bind_assembly(py::module_& m) {
       "assemble_contact",
       [](const ContactQuadrature& q, double eps_n, double eps_t, double mu, const carray& u,
          const carray& gtp_old, std::optional<py::array_t<double, py::array::c_style>> b,
-         std::optional<Mat> A, bool finite_difference, double fd_step) {
+         std::optional<Mat> A, bool finite_difference, double fd_step, double closed_gap) {
         std::span<double> bs;
         if (b) {
           if (b->size() != u.size())
@@ -138,9 +138,9 @@ void bind_assembly(py::module_& m) {
         }
         const auto mode = finite_difference ? contact::TangentMode::finite_difference
                                             : contact::TangentMode::exact;
-        contact::ContactPointState s =
-            contact::assemble_contact(q, contact::CoulombPenalty{eps_n, eps_t, mu}, as_span(u, "u"),
-                                      as_span(gtp_old, "gtp_old"), bs, insert, mode, fd_step);
+        contact::ContactPointState s = contact::assemble_contact(
+            q, contact::CoulombPenalty{eps_n, eps_t, mu}, as_span(u, "u"),
+            as_span(gtp_old, "gtp_old"), bs, insert, mode, fd_step, closed_gap);
         const auto nq = py::ssize_t(q.size());
         std::vector<std::int8_t> st(s.state.size());
         for (std::size_t p = 0; p < st.size(); ++p)
@@ -159,7 +159,7 @@ void bind_assembly(py::module_& m) {
       },
       py::arg("quadrature"), py::arg("eps_n"), py::arg("eps_t"), py::arg("mu"), py::arg("u"),
       py::arg("gtp_old"), py::arg("b") = py::none(), py::arg("A") = py::none(),
-      py::arg("finite_difference") = false, py::arg("fd_step") = 1e-8,
+      py::arg("finite_difference") = false, py::arg("fd_step") = 1e-8, py::arg("closed_gap") = 0.0,
       "Contact residual (added into the local array b) and tangent (added into the PETSc Mat A "
       "by local block indices; call A.assemble() after) of eq 48. Returns a dict of per-point "
       "g_n, g_t, tau_n, tau_t, state (int8 ContactState) and gtp_trial (None when mu == 0).");

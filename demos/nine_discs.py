@@ -1,0 +1,155 @@
+#!/usr/bin/python3
+"""Nine discs in four deformable plates under isotropic compression (paper 5.2.1).
+
+Physics. Nine discs (R = 1.7 mm, E = 100 GPa, nu = 0.3, plane strain) on a 3 x 3 lattice,
+confined by four deformable plates (1 mm x 9.8 mm) whose outer faces move inward by
+--displacement per step; Coulomb friction mu everywhere. The discs overlap their neighbours
+and the plates by --overlap at the start (the paper's "initial gaps": a disc whose contacts
+are all open is free, and the first Newton iteration would be singular). Every pair is found
+by the broad phase and meshed by the intermediate contact surface of its two level sets.
+
+The check. The set-up has the square's symmetry group D4 (4 rotations, 4 reflections) and so
+must the answer: every contact's normal and tangential force and the stress at every material
+point are compared with their images under the 8 maps, relative to the largest (1e-6 asked);
+every body is in equilibrium (resultant of its contact forces, plates: plus supports); Newton
+iterations per step (the paper: 4).
+
+Run: /usr/bin/python3 demos/nine_discs.py [--h 0.1] [--mu 0.5]
+Results and discussion: docs/demos.md#nine-discs
+"""
+
+import sys
+
+import numpy as np
+
+from dolfinx_forms import cli
+from dolfinx_forms.boundary import Dirichlet
+from dolfinx_forms.mpm import ImplicitMPM, MPMBody
+from dolfinx_forms.mpm_output import plot_force_chains, run_steps
+from meshes.mpm import nine_discs
+
+# fmt: off
+OPTIONS = [  # option, kind, default[, help]
+    ("--R", "(0, inf)", 1.7, "disc radius (mm)"),
+    ("--E", "(0, inf)", 100e3, "Young's modulus (N/mm^2)"),
+    ("--nu", "(-1, 0.5)", 0.3),
+    ("--mu", "(0, inf)", 0.5, "friction coefficient (> 0: frictionless discs turn freely)"),
+    ("--displacement", "(0, inf)", 1e-4, "inward motion of each plate per step (mm)"),
+    ("--overlap", "(0, inf)", 1e-3, "initial overlap of touching bodies (mm)"),
+    ("--steps", range(1, 1001), 1),
+    ("--h", "(0, inf)", 0.1, "grid spacing (mm); must divide 3 R + 1"),
+    ("--eps0", "(0, inf)", 1.0),
+]
+COLUMNS = ["step", "displacement", "force_left", "force_right", "force_bottom", "force_top",
+           "newton_iterations", "wall_s"]
+# fmt: on
+D4 = [np.array(m, float) for m in ([[1, 0], [0, 1]], [[0, -1], [1, 0]], [[-1, 0], [0, -1]],
+      [[0, 1], [-1, 0]], [[-1, 0], [0, 1]], [[1, 0], [0, -1]], [[0, 1], [1, 0]],
+      [[0, -1], [-1, 0]])]
+
+
+def parse(argv):
+    p = cli.demo_parser("nine_discs.py", __doc__, "results/nine_discs", OPTIONS, discretization=False)
+    a = p.parse_args(argv)
+    k = (3 * a.R + 1.0) / a.h
+    if abs(k - round(k)) > 1e-9 * k or not 10 <= a.R / a.h <= 200:
+        p.error(f"--h: must divide 3 R + 1 = {3 * a.R + 1:g} with 10 <= R/h <= 200, got {a.h}")
+    if not a.overlap <= 0.5 * a.h:
+        p.error(f"--overlap: must be in (0, h/2] = (0, {0.5 * a.h:g}], got {a.overlap}")
+    if not a.steps * a.displacement <= 0.1 * a.R:
+        p.error(f"--displacement: steps x displacement must be <= 0.1 R = {0.1 * a.R:g}")
+    return a
+
+
+def build(run):
+    p = run.params
+    grid, bodies, scene, faces = nine_discs(run.comm, R=p["R"], h=p["h"], overlap=p["overlap"])
+    run.data["faces"] = faces
+    bcs = [Dirichlet(lambda x, a=axis, c=c: np.isclose(x[a], c, rtol=0, atol=1e-9 * abs(c)),
+                     axis, -np.sign(c) * p["displacement"]) for axis, c in faces.values()]
+    return ImplicitMPM(
+        run.comm, grid, [MPMBody(n, t, (p["E"], p["nu"]), s) for n, t, s in bodies], scene,
+        dirichlet=bcs, mu=p["mu"], eps0=p["eps0"], timer=run.timer,
+    )
+
+
+def row(run, rec):
+    f = rec["body_forces"]
+    return dict(step=rec["step"], displacement=rec["step"] * run.params["displacement"],
+                force_left=-f["plate_left"][0], force_right=f["plate_right"][0],
+                force_bottom=-f["plate_bottom"][1], force_top=f["plate_top"][1],
+                newton_iterations=rec["newton_iterations"], wall_s=rec["wall_s"])
+
+
+def symmetry_error(sim, rec):
+    """Largest relative differences under D4: contact forces (by the contact's centre) and the
+    stress at the material points (by position)."""
+    from scipy.spatial import cKDTree
+
+    act = [q for q in rec["pairs"] if q["normal_force"] > 0]
+    c = np.array([[q["x"], q["y"]] for q in act])
+    fn = np.array([q["normal_force"] for q in act])
+    ft = np.abs([q["tangential_force"] for q in act])
+    x = np.concatenate([p.x for p in sim.points.values()])
+    s = np.concatenate([p.stress for p in sim.points.values()])
+    S = np.stack([np.stack([s[:, 0], s[:, 2]], 1), np.stack([s[:, 2], s[:, 1]], 1)], 1)
+    tc, tx = cKDTree(c), cKDTree(x)
+    e_f = e_s = e_x = 0.0
+    n_same = len(x)
+    for G in D4:
+        d, k = tc.query(c @ G.T)
+        e_x = max(e_x, d.max())
+        e_f = max(e_f, np.max(np.abs(fn[k] - fn)), np.max(np.abs(ft[k] - ft)))
+        # stresses at the points whose image is a point: those of the interior cells' tensor
+        # Gauss rule (the cut cells' sub-triangle rule is not D4-invariant)
+        d, k = tx.query(x @ G.T)
+        same = d < 1e-9 * np.abs(x).max()
+        Sg = np.einsum("ab,nbc,dc->nad", G, S, G)
+        e_s = max(e_s, np.max(np.abs(S[k[same]] - Sg[same])))
+        n_same = min(n_same, int(same.sum())) if G is not D4[0] else int(same.sum())
+    return e_f / fn.max(), e_s / np.abs(S).max(), e_x, n_same / len(x)
+
+
+def evaluate(run):
+    sim, rec = run.sim, run.records[-1]
+    e_f, e_s, e_x, frac = symmetry_error(sim, rec)
+    forces = np.array([v[:2] for v in rec["body_forces"].values()])
+    fmax = max(q["normal_force"] for q in rec["pairs"])
+    eq = max(  # contacts + supports (the plates' outer faces) on every body
+        np.hypot(*(np.add(rec["body_forces"][n][:2], rec["support_forces"][n])))
+        for n in rec["body_forces"]
+    ) / fmax
+    run.results.update(
+        symmetry_force_rel=e_f, symmetry_stress_rel=e_s, symmetry_position_max=e_x,
+        symmetry_points_compared=frac,
+        equilibrium_rel=eq, newton_iterations=[r["newton_iterations"] for r in run.records],
+        contacts=len([q for q in rec["pairs"] if q["normal_force"] > 0]),
+        max_normal_force=fmax, plate_forces=forces[-4:].tolist(),
+    )
+    warn = run.metrics["solver"]["warnings"]
+    if max(e_f, e_s) > 1e-6:
+        warn.append(f"D4 symmetry broken: forces {e_f:.1e}, stresses {e_s:.1e} (> 1e-6)")
+    if eq > 1e-8:
+        warn.append(f"a body is out of equilibrium by {eq:.1e} of the largest contact force")
+
+
+def plots(run, folder):
+    plot_force_chains(run.sim, run.records[-1], folder / "force_chains.png", "nine discs")
+
+
+def summary(run):
+    r = run.results
+    return (f"nine discs: {r['contacts']} contacts, largest normal force {r['max_normal_force']:.5g} "
+            f"N/mm; D4 symmetry: forces {r['symmetry_force_rel']:.1e}, stresses "
+            f"{r['symmetry_stress_rel']:.1e}; equilibrium {r['equilibrium_rel']:.1e}; "
+            f"Newton {r['newton_iterations']}")
+
+
+def main(argv=None):
+    args = parse(sys.argv[1:] if argv is None else argv)
+    return run_steps("nine_discs", vars(args), build, args.steps, row, COLUMNS,
+                     evaluate=evaluate, plots=plots, summary=summary, series_every=1)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
