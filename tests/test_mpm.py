@@ -200,3 +200,29 @@ def test_disc_column_carries_the_load_through_every_contact():
             s = rec["support_forces"][name]
             assert np.hypot(f[0] + s[0], f[1] + s[1]) <= 1e-8 * F.max(), name
     assert rec["obstacles"]["platen_top"]["fy"] == pytest.approx(F.max(), rel=1e-6)
+
+
+def test_hexagonal_assembly_of_ellipses_in_rigid_plates():
+    """15 elliptic grains (aspect 1.1) on a hexagonal lattice, overlapping, in four rigid plates
+    moved inward, mu = tan 15 deg: two compression steps converge, every grain is in
+    equilibrium (its contact resultant below 1e-8 of the largest contact force) and so is the
+    set of plates."""
+    from meshes.assembly import grain_assembly
+
+    grid, bodies, plates, build, box, _ = grain_assembly(COMM, 15, h=0.5, aspect=1.1, overlap=0.01)
+    d = 0.01
+    for name, v in (("plate_left", (d, 0)), ("plate_right", (-d, 0)),
+                    ("plate_bottom", (0, d)), ("plate_top", (0, -d))):
+        plates[name].translation = np.array(v)
+    sim = ImplicitMPM(
+        COMM, grid, [MPMBody(n, t, (100e3, 0.2), s) for n, t, s in bodies], build,
+        obstacles=list(plates.values()), mu=np.tan(np.radians(15)), predictor_gap=0.25, **quiet,
+    )
+    for _ in range(2):
+        rec = sim.step()
+    fmax = max(p["normal_force"] for p in rec["pairs"])
+    for name, f in rec["body_forces"].items():
+        assert np.hypot(f[0], f[1]) <= 1e-8 * fmax, name
+    ob = rec["obstacles"]  # the plates' forces balance (friction on them included)
+    assert np.hypot(*np.sum([[o["fx"], o["fy"]] for o in ob.values()], axis=0)) <= 1e-8 * fmax
+    assert ob["plate_top"]["fy"] > 0 and len([p for p in rec["pairs"] if p["normal_force"] > 0]) >= 30

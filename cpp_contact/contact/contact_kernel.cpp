@@ -147,6 +147,10 @@ ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPena
         continue;
       predictor = true;
       D = {1.0 / law.eps_n, 0.0, 0.0, friction ? 1.0 / law.eps_t : 0.0};
+    } else if (closed_gap > 0 and s.state[p] == ContactState::slip and friction) {
+      // ... and in that predictor a slipping point sticks: a grain whose contacts all slip
+      // has no tangential stiffness in its first iterate (the residual stays exact)
+      D = {1.0 / law.eps_n, 0.0, 0.0, 1.0 / law.eps_t};
     }
 
     if (!b.empty() and !predictor) {

@@ -74,9 +74,10 @@ enum class TangentMode { exact, finite_difference };
 /// @param[in] insert Receives element matrices, or empty to skip the tangent
 /// @param[in] mode Exact or finite-difference tangent
 /// @param[in] fd_step Perturbation of the FD tangent (displacement units)
-/// @param[in] closed_gap Open points with g_n < closed_gap add the tangent of a closed,
-/// sticking point (and no residual): a predictor for bodies held only by contacts that touch
-/// but are not yet closed (0: off, the exact tangent)
+/// @param[in] closed_gap > 0 selects the predictor tangent: open points with g_n < closed_gap
+/// add the tangent of a closed, sticking point (and no residual), slipping points the sticking
+/// tangent: for bodies held only by contacts that touch but are not yet closed, or that all
+/// slip in a first iterate far from equilibrium (0: off, the exact tangent)
 /// @return Per-point gaps, tractions, trial slip and states
 ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPenalty& law,
                                    std::span<const double> u, std::span<const double> gtp_old,
