@@ -1,0 +1,39 @@
+"""demos/nine_discs.py end to end (in-process, defaults): D4 symmetry of the contact forces and
+stresses, equilibrium of every body, the output files; bad input."""
+
+import importlib.util
+import json
+from pathlib import Path
+
+import pytest
+
+_spec = importlib.util.spec_from_file_location(
+    "nine_discs", Path(__file__).resolve().parents[1] / "demos" / "nine_discs.py"
+)
+demo = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(demo)
+
+
+def test_defaults_are_symmetric_and_balanced(tmp_path):
+    out = tmp_path / "nine"
+    assert demo.main(["--out", str(out)]) == 0
+    m = json.load(open(out / "metrics.json"))
+    r = m["results"]
+    assert r["contacts"] == 24
+    assert r["symmetry_force_rel"] <= 1e-6 and r["symmetry_stress_rel"] <= 1e-6
+    assert r["symmetry_points_compared"] > 0.9
+    assert r["equilibrium_rel"] <= 1e-8
+    assert m["solver"]["warnings"] == []
+    for f in ("steps.csv", "contacts.csv", "bodies.csv", "force_chains.png"):
+        assert (out / f).exists(), f
+
+
+@pytest.mark.parametrize(
+    "args, word",
+    [(["--mu", "0"], "--mu"), (["--h", "0.3"], "--h"), (["--overlap", "1"], "--overlap")],
+)
+def test_bad_input(args, word, tmp_path, capsys):
+    with pytest.raises(SystemExit) as e:
+        demo.main(args + ["--out", str(tmp_path / "x")])
+    assert e.value.code == 2 and word in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
