@@ -15,6 +15,16 @@ from petsc4py import PETSc
 from .laws import as_law
 
 
+def _law_key(law):
+    """Laws that are the same: one object, or a shipped law class with equal parameters (a
+    user's law is compared by identity: its UFL may hold more than its numbers)."""
+    from .laws import LAWS
+
+    if type(law) in LAWS.values():
+        return (type(law), tuple(sorted((k, v) for k, v in law.describe().items())))
+    return id(law)
+
+
 class BulkForms:
     """Forms of the bulk for displacement u (a Function of the vector Lagrange space V).
 
@@ -58,13 +68,20 @@ class BulkForms:
             elif nonlinear:
                 md = {"quadrature_degree": 2 * p}
             dx = ufl.Measure("dx", domain=mesh, subdomain_data=scene.cell_tags, metadata=md)
-            return dx if tag is None else dx(int(tag))
+            if tag is None:
+                return dx
+            return dx(tuple(int(t) for t in tag)) if np.ndim(tag) else dx(int(tag))
 
         self.measure = measure
-        lin = [law.residual(u, v, measure(t)) for t, law in self.laws.items() if law.linear]
+        # one integral per distinct law, over all its bodies (100 grains of one material: one
+        # FFCx kernel, not 100)
+        groups = {}
+        for t, law in self.laws.items():
+            groups.setdefault(_law_key(law), (law, []))[1].append(t)
+        lin = [law.residual(u, v, measure(ts)) for law, ts in groups.values() if law.linear]
         nl = [
-            law.residual(u, v, measure(t, nonlinear=True))
-            for t, law in self.laws.items()
+            law.residual(u, v, measure(ts, nonlinear=True))
+            for law, ts in groups.values()
             if not law.linear
         ]
         a_lin = [ufl.derivative(sum(lin[1:], lin[0]), u, du)] if lin else []

@@ -371,7 +371,7 @@ class ImplicitMPM:
     def _evolve(self, problem, scene):
         """Extend du off each body (eq 20), advect its level set (eq 19), reinitialise on drift."""
         V = problem.V
-        nx = len(self.xlines)
+        nx, ny = len(self.xlines), len(self.ylines)
         xdof = V.tabulate_dof_coordinates()[:, :2]
         i = np.rint((xdof[:, 0] - self.xlines[0]) / self.h).astype(np.int64)
         j = np.rint((xdof[:, 1] - self.ylines[0]) / self.h).astype(np.int64)
@@ -398,17 +398,34 @@ class ImplicitMPM:
             # eq 20 fills the rest of the grid. (Extending from the inside nodes only would move
             # the interface by du at a node up to h inside: first order, and the level set
             # would lag the material by ~ h grad(du) per step.)
-            known = has > 0
-            vel = _cpp.extend_normal(self.grid, phi.values.ravel(), known.astype(np.int8), vel)
-            self.grid_increments[b.name] = vel
-            r = _cpp.advect_levelset(phi, np.ascontiguousarray(vel), 1.0, 0.5)
+            known = (has > 0).reshape(ny, nx)
+            # a window of the grid around the body (its active nodes grown by 6 cells and the
+            # step's largest motion): a grain costs its own size, not the grid's. Beyond it the
+            # level set keeps its (positive, far-field) values.
+            jj, ii = np.nonzero(known)
+            m = 6 + int(np.ceil(np.abs(vel).max() / self.h))
+            i0, i1 = max(ii.min() - m, 0), min(ii.max() + m, nx - 1)
+            j0, j1 = max(jj.min() - m, 0), min(jj.max() + m, ny - 1)
+            win = (slice(j0, j1 + 1), slice(i0, i1 + 1))
+            sub = _cpp.StructuredGrid(self.xlines[i0 : i1 + 1], self.ylines[j0 : j1 + 1])
+            values = phi.values  # (ny, nx) copy
+            v = vel.reshape(ny, nx, 2)[win].reshape(-1, 2)
+            v = _cpp.extend_normal(
+                sub, values[win].ravel(), known[win].ravel().astype(np.int8), np.ascontiguousarray(v)
+            )
+            full = np.zeros((ny, nx, 2))
+            full[win] = v.reshape(j1 - j0 + 1, i1 - i0 + 1, 2)
+            self.grid_increments[b.name] = full.reshape(-1, 2)
+            r = _cpp.advect_levelset(_cpp.LevelSet(sub, values[win].ravel()), v, 1.0, 0.5)
             new = r["levelset"]
             drift = float(_cpp.levelset_gradient_drift(new, 3 * self.h))
             redo = drift > self.reinit_drift
             if redo:
                 new = _cpp.reinitialize(new)
-            self.levelsets[b.tag] = new
-            out["area_levelset"][b.name] = float(_cpp.levelset_area(new))
+            area = float(_cpp.levelset_area(new))
+            values[win] = new.values
+            self.levelsets[b.tag] = _cpp.LevelSet(self.grid, values.ravel())
+            out["area_levelset"][b.name] = area
             out["advection_substeps"][b.name] = int(r["substeps"])
             out["reinitialized"][b.name] = bool(redo)
             out["gradient_drift"][b.name] = drift
