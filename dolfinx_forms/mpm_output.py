@@ -10,8 +10,9 @@ set and extended step displacement). The series store raw little-endian float64 
 .xdmf (XDMF "Binary" items; no HDF5 needed), one frame every `series_every` steps.
 
 `run_steps` is the skeleton of a multi-step demo, as `demo.run_case` is for one load path:
-metrics record and phase timer -> build the simulation -> steps (a ContactSolverError ends the
-run: one line on stderr, nothing written, exit status 1) -> evaluate (rank 0) -> one atomic
+metrics record and phase timer -> build the simulation -> steps (a ContactSolverError or a
+RuntimeError of the step's geometry ends the run: one line on stderr, nothing written, exit
+status 1) -> evaluate (rank 0) -> one atomic
 folder -> summary and "results in ...".
 """
 
@@ -200,7 +201,7 @@ def run_steps(
                 x0 = {t: p.x - d for (t, p), d in zip(run.sim.points.items(), run.sim.first_step_du)}
             if comm.rank == 0 and ((k + 1) % series_every == 0 or k + 1 == num_steps or k == 0):
                 add_frames(run.sim, points_series, grid_series, rec["step"], x0)
-    except ContactSolverError as e:
+    except (ContactSolverError, RuntimeError) as e:  # Newton, or the geometry of a step
         if comm.rank == 0:
             sys.stderr.write(f"{prog}: step {len(run.records) + 1}: {e}\n")
         return 1
