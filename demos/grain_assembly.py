@@ -1,0 +1,157 @@
+#!/usr/bin/python3
+"""A grain assembly in four rigid plates: isotropic compression, then simple shear (paper 5.3.2).
+
+Physics. --grains elliptic grains (aspect 1.1, mean radius 5 mm, E = 100 GPa, nu = 0.2, plane
+strain) on a hexagonal lattice, each overlapping its neighbours and the outermost ones the
+plates by 0.02 h (a grain whose contacts are all open would make the step singular; the paper
+enlarges its grains by 0.5 h for the same reason), friction angle --friction-angle. Phase 1:
+the four rigid plates move toward the centre by --compression per step for --steps steps.
+Phase 2 (simple shear): top and bottom plates fixed, the lateral plates turn about their bottom
+ends by --shear-rotation per step for --shear-steps steps. Grains, pairs (broad phase), contact
+surfaces and level sets are rebuilt every step (ImplicitMPM).
+
+The check. Every grain in equilibrium at every step (its contact resultant below 1e-8 of the
+largest contact force), the plates' forces in balance; the normal and tangential forces on the
+plates per step (steps.csv), the force chains at the end of each phase.
+
+Run: /usr/bin/python3 demos/grain_assembly.py [--grains 15] [--friction-angle 30]
+Results and discussion: docs/demos.md#disc-column-and-assemblies
+"""
+
+import sys
+
+import numpy as np
+
+from dolfinx_forms import cli
+from dolfinx_forms.mpm import ImplicitMPM, MPMBody
+from dolfinx_forms.mpm_output import plot_force_chains, run_steps
+from meshes.assembly import grain_assembly
+
+# fmt: off
+OPTIONS = [  # option, kind, default[, help]
+    ("--grains", range(2, 1001), 15),
+    ("--radius", "(0, inf)", 5.0, "mean grain radius (mm)"),
+    ("--E", "(0, inf)", 100e3, "Young's modulus (N/mm^2)"),
+    ("--nu", "(-1, 0.5)", 0.2),
+    ("--friction-angle", "(0, 60]", 15.0, "degrees (mu = tan of it)"),
+    ("--compression", "(0, inf)", 0.01, "inward motion of each plate per step (mm)"),
+    ("--steps", range(0, 1001), 30, "compression steps"),
+    ("--shear-rotation", "[0, 0.01]", 0.3 / 180, "rotation of the lateral plates per step (rad)"),
+    ("--shear-steps", range(0, 1001), 30),
+    ("--h", "(0, inf)", 0.5, "grid spacing (mm)"),
+    ("--eps0", "(0, inf)", 1.0),
+]
+PLATES = ("plate_left", "plate_right", "plate_bottom", "plate_top")
+COLUMNS = ["step", "phase"] + [f"{p}_{c}" for p in PLATES for c in ("normal", "tangential")] + [
+    "newton_iterations", "wall_s"]
+# fmt: on
+
+
+def parse(argv):
+    p = cli.demo_parser("grain_assembly.py", __doc__, "results/grain_assembly", OPTIONS,
+                        discretization=False)
+    a = p.parse_args(argv)
+    if not 5 <= a.radius / a.h <= 100:
+        p.error(f"--h: must give 5 <= radius/h <= 100 (radius {a.radius:g}), got {a.h}")
+    if not a.compression <= 0.1 * a.h:
+        p.error(f"--compression: must be <= h/10 = {0.1 * a.h:g} per step, got {a.compression}")
+    if not a.steps * a.compression <= 0.1 * a.radius:
+        p.error(f"--compression: steps x compression must be <= 0.1 radius = {0.1 * a.radius:g}")
+    if a.steps + a.shear_steps == 0:
+        p.error("--steps: at least one compression or shear step is needed")
+    return a
+
+
+def build(run):
+    p = run.params
+    grid, bodies, plates, scene, box, _ = grain_assembly(
+        run.comm, p["grains"], p["radius"], p["h"], aspect=1.1, overlap=0.02 * p["h"]
+    )
+    d = p["compression"]
+    for name, t in zip(PLATES, ((d, 0), (-d, 0), (0, d), (0, -d))):
+        plates[name].translation = np.array(t, float)
+    run.data.update(plates=plates, height=box[1, 1] - box[0, 1])
+    return ImplicitMPM(
+        run.comm, grid, [MPMBody(n, t, (p["E"], p["nu"]), s) for n, t, s in bodies], scene,
+        obstacles=list(plates.values()), mu=np.tan(np.radians(p["friction_angle"])),
+        eps0=p["eps0"], predictor_gap=0.5 * p["h"], timer=run.timer,
+    )
+
+
+def row(run, rec):
+    """Plate forces in each plate's frame (normal: compression positive) after the step; at the
+    end of the compression the lateral plates start turning (simple shear)."""
+    p, plates = run.params, run.data["plates"]
+    out = dict(step=rec["step"], phase="compression" if rec["step"] <= p["steps"] else "shear",
+               newton_iterations=rec["newton_iterations"], wall_s=rec["wall_s"])
+    inward = {"plate_left": (1, 0), "plate_right": (-1, 0), "plate_bottom": (0, 1),
+              "plate_top": (0, -1)}
+    for name in PLATES:
+        a = plates[name].angle
+        m = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]]) @ inward[name]
+        f = np.array([rec["obstacles"][name]["fx"], rec["obstacles"][name]["fy"]])
+        out[f"{name}_normal"] = float(-f @ m)
+        out[f"{name}_tangential"] = float(f @ np.array([-m[1], m[0]]))
+    if rec["step"] == p["steps"]:  # compression done: turn the lateral plates from now on
+        run.data["end_of_compression"] = rec
+        for name in PLATES:
+            plates[name].translation = np.zeros(2)
+        for name in ("plate_left", "plate_right"):
+            plates[name].rotation = -p["shear_rotation"]
+    return out
+
+
+def evaluate(run):
+    worst, warn = 0.0, run.metrics["solver"]["warnings"]
+    for rec in run.records:
+        fmax = max([q["normal_force"] for q in rec["pairs"]] + [1e-300])
+        grains = max(np.hypot(*f[:2]) for f in rec["body_forces"].values()) / fmax
+        plates = np.hypot(*np.sum([[o["fx"], o["fy"]] for o in rec["obstacles"].values()], 0))
+        worst = max(worst, grains, plates / fmax)
+    run.results.update(
+        equilibrium_rel_max=float(worst),
+        newton_iterations=[r["newton_iterations"] for r in run.records],
+        contacts_final=len([q for q in run.records[-1]["pairs"] if q["normal_force"] > 0]),
+        top_normal_final=run.rows[-1]["plate_top_normal"],
+        top_tangential_final=run.rows[-1]["plate_top_tangential"],
+    )
+    if worst > 1e-8:
+        warn.append(f"equilibrium of the grains or plates off by {worst:.1e} (> 1e-8)")
+
+
+def plots(run, folder):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    plot_force_chains(run.sim, run.records[-1], folder / "force_chains.png", "grain assembly")
+    fig, ax = plt.subplots(figsize=(6, 4))
+    steps = [r["step"] for r in run.rows]
+    for name in ("plate_top", "plate_left"):
+        ax.plot(steps, [r[f"{name}_normal"] for r in run.rows], "-", label=f"{name} normal")
+        ax.plot(steps, [r[f"{name}_tangential"] for r in run.rows], "--", label=f"{name} tangential")
+    ax.axvline(run.params["steps"] + 0.5, color="0.6", ls=":")
+    ax.set(xlabel="step", ylabel="force (N/mm)", title="plate forces (compression | shear)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(folder / "plate_forces.png", dpi=120)
+    plt.close(fig)
+
+
+def summary(run):
+    r = run.results
+    return (f"grain assembly: {run.params['grains']} grains, {len(run.rows)} steps, "
+            f"{r['contacts_final']} contacts at the end, top plate N = {r['top_normal_final']:.5g}, "
+            f"T = {r['top_tangential_final']:.4g} N/mm; equilibrium {r['equilibrium_rel_max']:.1e}; "
+            f"Newton per step {np.mean(r['newton_iterations']):.1f}")
+
+
+def main(argv=None):
+    args = parse(sys.argv[1:] if argv is None else argv)
+    return run_steps("grain_assembly", vars(args), build, args.steps + args.shear_steps, row,
+                     COLUMNS, evaluate=evaluate, plots=plots, summary=summary)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
