@@ -94,6 +94,30 @@ def shape_values(shape, points):
     return np.asarray(shape(points), float)
 
 
+def grid_cells(X, Y, phi):
+    """The active cells of a level set on the tensor grid X x Y (node values phi, x-fastest):
+    quads (nc, 4) vertex indices in DOLFINx order, active (nc,) (min phi < 0 at the vertices),
+    kinds of the active cells (CUT if max phi > 0, else INTERIOR) and the bounding box (2, 2)
+    of the material (vertices inside plus the ends of the zero contour in the cut cells). The
+    one classification of cells: the cut scenes (meshes.cut) and the MPM's reuse test use it."""
+    nx, ny = len(X) - 1, len(Y) - 1
+    pts = np.stack(np.meshgrid(X, Y), axis=-1).reshape(-1, 2)
+    v = (np.arange(ny)[:, None] * (nx + 1) + np.arange(nx)[None, :]).ravel()
+    quads = np.stack([v, v + 1, v + nx + 1, v + nx + 2], axis=1)
+    pc = phi[quads]
+    active = pc.min(axis=1) < 0
+    kinds = np.where(pc[active].max(axis=1) > 0, CUT, INTERIOR).astype(np.int32)
+    bbox = None
+    if active.any():
+        cut = quads[active][kinds == CUT]
+        c = _cpp.cell_contours(phi[cut])  # marching squares of the cut kernels (linear crossings)
+        k, e = np.nonzero(np.isfinite(c["t"]))
+        a, b = (cut[k, np.asarray(c["edges"])[e, m]] for m in (0, 1))
+        found = np.concatenate([pts[phi <= 0], pts[a] + c["t"][k, e][:, None] * (pts[b] - pts[a])])
+        bbox = np.array([found.min(axis=0), found.max(axis=0)])
+    return dict(points=pts, quads=quads, active=active, kinds=kinds, bbox=bbox)
+
+
 def levelset_values(scene, V):
     """A Function on the scalar Q1 space V of scene.mesh holding at each dof the cut shape of the
     body owning it (the bodies are disjoint: every dof belongs to one body); ghosts updated."""

@@ -5,7 +5,10 @@ rigid level sets (`obstacles.py`). One load step:
 
 1. the cut scene of the current level sets (`build_scene`, supplied by the application, e.g.
    `meshes.mpm.grid_scene`): active cells, integration points; Gamma_c and the closest points
-   come from the current grid level sets (eqs 21-25), never from the initial shapes;
+   come from the current grid level sets (eqs 21-25), never from the initial shapes. The
+   DOLFINx mesh is rebuilt only when a body's active cells or their kinds (or the pairs)
+   change; forms and sparsity are made anew every step, because the cut weights and the
+   contact couplings move with the level sets;
 2. the material points' stress is projected to the integration points of the new cells by MLS
    (eqs 38-45, `_cpp.MLSProjector`), per body, and enters the residual as the initial stress
    int sigma_0 : grad v;
@@ -39,6 +42,7 @@ from mpi4py import MPI
 from . import _cpp
 from . import material_points as mp
 from .boundary import Load
+from .cut import grid_cells
 from .laws import as_law
 from .parallel import allreduce_array
 from .newton import ContactSolverError  # noqa: F401  (raised by step)
@@ -111,6 +115,7 @@ class ImplicitMPM:
         self.step_count = 0
         self.problem = None
         self.scene = None
+        self._key = None  # _scene_key of self.scene
 
     # ------------------------------------------------------------------ state
     def phase(self, name):
@@ -149,7 +154,15 @@ class ImplicitMPM:
         t0 = time.perf_counter()
         with self.phase("mesh"):
             pairs = self.candidate_pairs()
-            scene = self.build_scene(dict(self.levelsets), pairs)
+            key, boxes = self._scene_key(pairs)
+            rebuilt = self.scene is None or key != self._key
+            if rebuilt:
+                scene = self.build_scene(dict(self.levelsets), pairs)
+            else:  # same active cells, kinds and pairs: the mesh and its tags stay
+                scene = self.scene
+                for body, b, box in zip(scene.bodies, self.bodies, boxes):
+                    body.shape = scene.cut.levelsets[b.tag] = self.levelsets[b.tag]
+                    body.bbox = box
         sigma0 = None
         if self.points is not None:
             with self.phase("mls"):
@@ -200,7 +213,7 @@ class ImplicitMPM:
         for ob in self.obstacles:
             ob.advance(1.0)
         self.step_count += 1
-        self.problem, self.scene = problem, scene
+        self.problem, self.scene, self._key = problem, scene, key
         imap = problem.V.dofmap.index_map
         record.update(
             step=self.step_count,
@@ -209,6 +222,7 @@ class ImplicitMPM:
             num_dofs=int(imap.size_global * problem.bs),
             num_cells=int(scene.mesh.topology.index_map(2).size_global),
             points_outside_cells=outside,
+            mesh_rebuilt=bool(rebuilt),
             mls_widened=mls_info["widened"],
             mass={b.name: float(self.points[b.tag].vol0.sum()) for b in self.bodies},
             volume_points={b.name: float(self.points[b.tag].vol.sum()) for b in self.bodies},
@@ -231,6 +245,16 @@ class ImplicitMPM:
             hi = np.array([X[inside].max(), Y[inside].max()]) + self.h
             out.append([lo, hi])
         return np.array(out)
+
+    def _scene_key(self, pairs):
+        """What decides the cut mesh: each body's active cells and their kinds (interior/cut,
+        `cut.grid_cells`), and the pairs; with the bodies' material boxes."""
+        key, boxes = [tuple(pairs)], []
+        for b in self.bodies:
+            g = grid_cells(self.xlines, self.ylines, self.levelsets[b.tag].values.ravel())
+            key += [g["active"].tobytes(), g["kinds"].tobytes()]
+            boxes.append(g["bbox"])
+        return key, boxes
 
     def candidate_pairs(self):
         """Body pairs whose boxes, inflated by the contact band (and the level-set grid of the

@@ -36,7 +36,14 @@ import dolfinx.fem
 import dolfinx.mesh
 import numpy as np
 import ufl
-from dolfinx_forms.cut import CUT, GHOST_FACET, INTERIOR, levelset_values, shape_values  # noqa: F401
+from dolfinx_forms.cut import (  # noqa: F401
+    CUT,
+    GHOST_FACET,
+    INTERIOR,
+    grid_cells,
+    levelset_values,
+    shape_values,
+)
 
 from .hertz import hertz_contact_box
 from .scene import Body, Scene, on_box_side, partitioner_kwargs, summary, tag_boundaries
@@ -205,30 +212,16 @@ def _body_grid(xlines, ylines, body):
     i0, i1 = _line_index(xlines, w[:, 0], f"body {body.name!r}: window x bounds")
     j0, j1 = _line_index(ylines, w[:, 1], f"body {body.name!r}: window y bounds")
     X, Y = xlines[i0 : i1 + 1], ylines[j0 : j1 + 1]
-    nx, ny = len(X) - 1, len(Y) - 1
     pts = np.stack(np.meshgrid(X, Y), axis=-1).reshape(-1, 2)  # vertex (i, j) is j (nx+1) + i
-    phi = shape_values(body.shape, pts)
-    v = (np.arange(ny)[:, None] * (nx + 1) + np.arange(nx)[None, :]).ravel()
-    quads = np.stack([v, v + 1, v + nx + 1, v + nx + 2], axis=1)
-    pc = phi[quads]
-    active = pc.min(axis=1) < 0
+    g = grid_cells(X, Y, shape_values(body.shape, pts))
+    quads, active, kinds = g["quads"], g["active"], g["kinds"]
     if not active.any():
         raise ValueError(
             f"body {body.name!r}: no active cell (cut shape >= 0 at every vertex of "
             f"window {w.tolist()})"
         )
-    kinds = np.where(pc[active].max(axis=1) > 0, CUT, INTERIOR).astype(np.int32)
     used, cells = np.unique(quads[active], return_inverse=True)
-    bbox = body.bbox
-    if bbox is None:  # vertices inside plus the ends of the zero contour in the cut cells
-        from dolfinx_forms import _cpp
-
-        cut = quads[active][kinds == CUT]
-        c = _cpp.cell_contours(phi[cut])  # marching squares of the cut kernels (linear crossings)
-        k, e = np.nonzero(np.isfinite(c["t"]))
-        a, b = (cut[k, np.asarray(c["edges"])[e, m]] for m in (0, 1))
-        found = np.concatenate([pts[phi <= 0], pts[a] + c["t"][k, e][:, None] * (pts[b] - pts[a])])
-        bbox = np.array([found.min(axis=0), found.max(axis=0)])
+    bbox = g["bbox"] if body.bbox is None else body.bbox
     return pts[used], cells.reshape(-1, 4), kinds, np.asarray(bbox, float)
 
 
