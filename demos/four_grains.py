@@ -32,7 +32,7 @@ from meshes.four_grains import check_contact_zones, four_grains, grain_outlines
 # fmt: off
 OPTIONS = [  # option, kind, default[, help]
     ("--radius", "(0, inf)", 2.0, "mean radius of the largest given grain size (mm)"),
-    ("--seed", range(0, 2**31), 1, "seed of the Fourier grain outline"),
+    ("--seed", int, 1, "seed of the Fourier grain outline, in [0, 2^31)"),
     ("--E", "(0, inf)", 10e3, "Young's modulus (N/mm^2)"),
     ("--nu", "(-1, 0.5)", 0.3),
     ("--mu", "(0, inf)", 0.5, "friction coefficient (> 0: frictionless grains turn freely)"),
@@ -54,6 +54,8 @@ def parse(argv):
         "four_grains.py", __doc__, "results/four_grains", OPTIONS, discretization=False
     )
     a = p.parse_args(argv)
+    if not 0 <= a.seed < 2**31:
+        p.error(f"--seed: must be in [0, 2^31), got {a.seed}")
     if not 5 <= a.radius / a.h <= 200:
         p.error(f"--h: must give 5 <= radius/h <= 200 (radius {a.radius:g}), got {a.h}")
     if not a.overlap <= 0.5 * a.h:
