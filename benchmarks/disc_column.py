@@ -34,8 +34,13 @@ E, nu = 100e3, 0.3
 comm = MPI.COMM_WORLD
 grid, bodies, platens, build = disc_column(comm, a.n, a.R, a.h, a.step, a.steps)
 sim = ImplicitMPM(
-    comm, grid, [MPMBody(n, t, (E, nu), s) for n, t, s in bodies], build, obstacles=platens,
-    dirichlet=[Dirichlet(lambda x: np.isclose(x[0], 0.0), 0, 0.0)], eps0=a.eps0,
+    comm,
+    grid,
+    [MPMBody(n, t, (E, nu), s) for n, t, s in bodies],
+    build,
+    obstacles=platens,
+    dirichlet=[Dirichlet(lambda x: np.isclose(x[0], 0.0), 0, 0.0)],
+    eps0=a.eps0,
     log=lambda *x, **k: None,
 )
 rows, t0 = [], time.perf_counter()
@@ -44,15 +49,28 @@ for k in range(a.steps):
     F = np.array([abs(p["fy"]) for p in rec["pairs"]])
     for p, f in zip(rec["pairs"], F):
         aH = 2 * np.sqrt(f * a.R * (1 - nu**2) / (np.pi * E))
-        rows.append(dict(step=rec["step"], pair=f"{p['body_i']}-{p['body_j']}", force=f,
-                         force_spread=float(np.ptp(F) / F.max()), half_width=p["half_width"],
-                         hertz=aH, rel_error=p["half_width"] / aH - 1, a_over_h=p["half_width"] / a.h,
-                         newton=rec["newton_iterations"], wall_s=rec["wall_s"]))
+        rows.append(
+            dict(
+                step=rec["step"],
+                pair=f"{p['body_i']}-{p['body_j']}",
+                force=f,
+                force_spread=float(np.ptp(F) / F.max()),
+                half_width=p["half_width"],
+                hertz=aH,
+                rel_error=p["half_width"] / aH - 1,
+                a_over_h=p["half_width"] / a.h,
+                newton=rec["newton_iterations"],
+                wall_s=rec["wall_s"],
+            )
+        )
     if comm.rank == 0:
-        print(f"step {k + 1}: F = {F.max():.5g}, spread {np.ptp(F) / F.max():.1e}, a/h "
-              f"{min(r['a_over_h'] for r in rows[-len(F):]):.2f}..{max(r['a_over_h'] for r in rows[-len(F):]):.2f}, "
-              f"max |a/aH - 1| {max(abs(r['rel_error']) for r in rows[-len(F):]):.3f}, "
-              f"Newton {rec['newton_iterations']}, {rec['wall_s']:.2f} s", flush=True)
+        print(
+            f"step {k + 1}: F = {F.max():.5g}, spread {np.ptp(F) / F.max():.1e}, a/h "
+            f"{min(r['a_over_h'] for r in rows[-len(F):]):.2f}..{max(r['a_over_h'] for r in rows[-len(F):]):.2f}, "
+            f"max |a/aH - 1| {max(abs(r['rel_error']) for r in rows[-len(F):]):.3f}, "
+            f"Newton {rec['newton_iterations']}, {rec['wall_s']:.2f} s",
+            flush=True,
+        )
 if comm.rank == 0:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -61,11 +79,15 @@ if comm.rank == 0:
         w.writeheader()
         w.writerows(rows)
     judged = [r for r in rows if r["a_over_h"] > 5]
-    summary = dict(params=vars(a), num_dofs=rec["num_dofs"], total_s=time.perf_counter() - t0,
-                   force_spread_max=max(r["force_spread"] for r in rows),
-                   judged=len(judged),
-                   rel_error_max_a_gt_5h=max((abs(r["rel_error"]) for r in judged), default=None),
-                   timing_s=dict(sim.timer.timing) if sim.timer else None)
+    summary = dict(
+        params=vars(a),
+        num_dofs=rec["num_dofs"],
+        total_s=time.perf_counter() - t0,
+        force_spread_max=max(r["force_spread"] for r in rows),
+        judged=len(judged),
+        rel_error_max_a_gt_5h=max((abs(r["rel_error"]) for r in judged), default=None),
+        timing_s=dict(sim.timer.timing) if sim.timer else None,
+    )
     (out / "disc_column.json").write_text(json.dumps(summary, indent=1))
     import matplotlib
 

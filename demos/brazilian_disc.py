@@ -47,19 +47,28 @@ COLUMNS = ["step", "displacement", "force_top", "force_bottom", "half_width_top"
 
 
 def parse(argv):
-    p = cli.demo_parser("brazilian_disc.py", __doc__, "results/brazilian_disc", OPTIONS,
-                        discretization=False)
+    p = cli.demo_parser(
+        "brazilian_disc.py", __doc__, "results/brazilian_disc", OPTIONS, discretization=False
+    )
     a = p.parse_args(argv)
     if not a.h <= a.R / 5:
-        p.error(f"--h: must be in (0, R/5] = (0, {a.R / 5:g}] (at least 10 cells across), got {a.h}")
+        p.error(
+            f"--h: must be in (0, R/5] = (0, {a.R / 5:g}] (at least 10 cells across), got {a.h}"
+        )
     if not a.R / a.h <= 2000:
-        p.error(f"--h: must be >= R/2000 = {a.R / 2000:g} (grid of at most 4000^2 cells), got {a.h}")
+        p.error(
+            f"--h: must be >= R/2000 = {a.R / 2000:g} (grid of at most 4000^2 cells), got {a.h}"
+        )
     if not a.steps * a.step_displacement <= 0.2 * a.R:
-        p.error(f"--step-displacement: steps x step must be <= 0.2 R = {0.2 * a.R:g} "
-                f"(small-strain MPM), got {a.steps * a.step_displacement:g}")
+        p.error(
+            f"--step-displacement: steps x step must be <= 0.2 R = {0.2 * a.R:g} "
+            f"(small-strain MPM), got {a.steps * a.step_displacement:g}"
+        )
     if not a.step_displacement <= 0.5 * a.h:
-        p.error(f"--step-displacement: must be <= h/2 = {0.5 * a.h:g} per step (contact band "
-                f"and level-set advection), got {a.step_displacement}")
+        p.error(
+            f"--step-displacement: must be <= h/2 = {0.5 * a.h:g} per step (contact band "
+            f"and level-set advection), got {a.step_displacement}"
+        )
     return a
 
 
@@ -75,8 +84,15 @@ def build(run):
     )
     symmetry = Dirichlet(lambda x: np.isclose(x[0], 0.0, atol=1e-9 * p["R"]), 0, 0.0)
     return ImplicitMPM(
-        run.comm, grid, [MPMBody(name, tag, (p["E"], p["nu"]), shape)], scene,
-        obstacles=platens, dirichlet=[symmetry], mu=p["mu"], eps0=p["eps0"], timer=run.timer,
+        run.comm,
+        grid,
+        [MPMBody(name, tag, (p["E"], p["nu"]), shape)],
+        scene,
+        obstacles=platens,
+        dirichlet=[symmetry],
+        mu=p["mu"],
+        eps0=p["eps0"],
+        timer=run.timer,
     )
 
 
@@ -110,7 +126,9 @@ def evaluate(run):
     vol = np.array([r["volume_points"] for r in rows])
     mass = [r["mass"]["disc"] for r in run.records]
     run.results.update(
-        force_top=F.tolist(), force_bottom=Fb.tolist(), half_width=a.tolist(),
+        force_top=F.tolist(),
+        force_bottom=Fb.tolist(),
+        half_width=a.tolist(),
         half_width_rel_error_max=float(err[judged].max()) if judged.any() else None,
         steps_judged=int(judged.sum()),
         force_balance_rel_max=float(balance.max()),
@@ -128,7 +146,9 @@ def evaluate(run):
     if balance.max() > 1e-6:
         warn.append(f"platen forces differ by {balance.max():.1e} relative (> 1e-6)")
     if run.results["area_vs_points_rel_max"] > 0.01:
-        warn.append(f"level-set area and point volume differ by {run.results['area_vs_points_rel_max']:.1%}")
+        warn.append(
+            f"level-set area and point volume differ by {run.results['area_vs_points_rel_max']:.1%}"
+        )
     run.results["mls_widened_points"] = int(sum(r["mls_widened"] for r in run.records))
 
 
@@ -152,11 +172,15 @@ def plots(run, folder):
     fig.savefig(folder / "half_width.png", dpi=120)
     plt.close(fig)
     frames = run.data["series"]["disc"].frames  # (step, x, {stress, ...}, cells)
-    frames = [frames[k] for k in sorted({0, len(frames) // 3, 2 * len(frames) // 3, len(frames) - 1})]
+    frames = [
+        frames[k] for k in sorted({0, len(frames) // 3, 2 * len(frames) // 3, len(frames) - 1})
+    ]
     fig, axes = plt.subplots(1, len(frames), figsize=(3.2 * len(frames), 3.4), squeeze=False)
     lo = min(f[2]["stress"][:, 1].min() for f in frames)
     for ax, (step, x, data, _) in zip(axes[0], frames):
-        sc = ax.scatter(x[:, 0], x[:, 1], c=data["stress"][:, 1], s=0.5, cmap="viridis", vmin=lo, vmax=0)
+        sc = ax.scatter(
+            x[:, 0], x[:, 1], c=data["stress"][:, 1], s=0.5, cmap="viridis", vmin=lo, vmax=0
+        )
         ax.set(aspect="equal", title=f"step {step:g}", xticks=[], yticks=[])
     fig.colorbar(sc, ax=axes[0].tolist(), label="sigma_yy at the material points (N/mm^2)")
     fig.savefig(folder / "sigma_yy.png", dpi=120)
@@ -179,8 +203,18 @@ def summary(run):
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
     params = vars(args)
-    return run_steps("brazilian", params, build, args.steps, row, COLUMNS, evaluate=evaluate,
-                     plots=plots, summary=summary, series_every=args.series_every)
+    return run_steps(
+        "brazilian",
+        params,
+        build,
+        args.steps,
+        row,
+        COLUMNS,
+        evaluate=evaluate,
+        plots=plots,
+        summary=summary,
+        series_every=args.series_every,
+    )
 
 
 if __name__ == "__main__":

@@ -48,8 +48,9 @@ COLUMNS = ["step", "phase"] + [f"{p}_{c}" for p in PLATES for c in ("normal", "t
 
 
 def parse(argv):
-    p = cli.demo_parser("grain_assembly.py", __doc__, "results/grain_assembly", OPTIONS,
-                        discretization=False)
+    p = cli.demo_parser(
+        "grain_assembly.py", __doc__, "results/grain_assembly", OPTIONS, discretization=False
+    )
     a = p.parse_args(argv)
     if not 5 <= a.radius / a.h <= 100:
         p.error(f"--h: must give 5 <= radius/h <= 100 (radius {a.radius:g}), got {a.h}")
@@ -72,9 +73,15 @@ def build(run):
         plates[name].translation = np.array(t, float)
     run.data.update(plates=plates, height=box[1, 1] - box[0, 1])
     return ImplicitMPM(
-        run.comm, grid, [MPMBody(n, t, (p["E"], p["nu"]), s) for n, t, s in bodies], scene,
-        obstacles=list(plates.values()), mu=np.tan(np.radians(p["friction_angle"])),
-        eps0=p["eps0"], predictor_gap=0.5 * p["h"], timer=run.timer,
+        run.comm,
+        grid,
+        [MPMBody(n, t, (p["E"], p["nu"]), s) for n, t, s in bodies],
+        scene,
+        obstacles=list(plates.values()),
+        mu=np.tan(np.radians(p["friction_angle"])),
+        eps0=p["eps0"],
+        predictor_gap=0.5 * p["h"],
+        timer=run.timer,
     )
 
 
@@ -82,10 +89,18 @@ def row(run, rec):
     """Plate forces in each plate's frame (normal: compression positive) after the step; at the
     end of the compression the lateral plates start turning (simple shear)."""
     p, plates = run.params, run.data["plates"]
-    out = dict(step=rec["step"], phase="compression" if rec["step"] <= p["steps"] else "shear",
-               newton_iterations=rec["newton_iterations"], wall_s=rec["wall_s"])
-    inward = {"plate_left": (1, 0), "plate_right": (-1, 0), "plate_bottom": (0, 1),
-              "plate_top": (0, -1)}
+    out = dict(
+        step=rec["step"],
+        phase="compression" if rec["step"] <= p["steps"] else "shear",
+        newton_iterations=rec["newton_iterations"],
+        wall_s=rec["wall_s"],
+    )
+    inward = {
+        "plate_left": (1, 0),
+        "plate_right": (-1, 0),
+        "plate_bottom": (0, 1),
+        "plate_top": (0, -1),
+    }
     for name in PLATES:
         a = plates[name].angle
         m = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]]) @ inward[name]
@@ -130,7 +145,9 @@ def plots(run, folder):
     steps = [r["step"] for r in run.rows]
     for name in ("plate_top", "plate_left"):
         ax.plot(steps, [r[f"{name}_normal"] for r in run.rows], "-", label=f"{name} normal")
-        ax.plot(steps, [r[f"{name}_tangential"] for r in run.rows], "--", label=f"{name} tangential")
+        ax.plot(
+            steps, [r[f"{name}_tangential"] for r in run.rows], "--", label=f"{name} tangential"
+        )
     ax.axvline(run.params["steps"] + 0.5, color="0.6", ls=":")
     ax.set(xlabel="step", ylabel="force (N/mm)", title="plate forces (compression | shear)")
     ax.legend(fontsize=8)
@@ -141,16 +158,27 @@ def plots(run, folder):
 
 def summary(run):
     r = run.results
-    return (f"grain assembly: {run.params['grains']} grains, {len(run.rows)} steps, "
-            f"{r['contacts_final']} contacts at the end, top plate N = {r['top_normal_final']:.5g}, "
-            f"T = {r['top_tangential_final']:.4g} N/mm; equilibrium {r['equilibrium_rel_max']:.1e}; "
-            f"Newton per step {np.mean(r['newton_iterations']):.1f}")
+    return (
+        f"grain assembly: {run.params['grains']} grains, {len(run.rows)} steps, "
+        f"{r['contacts_final']} contacts at the end, top plate N = {r['top_normal_final']:.5g}, "
+        f"T = {r['top_tangential_final']:.4g} N/mm; equilibrium {r['equilibrium_rel_max']:.1e}; "
+        f"Newton per step {np.mean(r['newton_iterations']):.1f}"
+    )
 
 
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
-    return run_steps("grain_assembly", vars(args), build, args.steps + args.shear_steps, row,
-                     COLUMNS, evaluate=evaluate, plots=plots, summary=summary)
+    return run_steps(
+        "grain_assembly",
+        vars(args),
+        build,
+        args.steps + args.shear_steps,
+        row,
+        COLUMNS,
+        evaluate=evaluate,
+        plots=plots,
+        summary=summary,
+    )
 
 
 if __name__ == "__main__":

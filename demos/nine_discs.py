@@ -43,13 +43,25 @@ OPTIONS = [  # option, kind, default[, help]
 COLUMNS = ["step", "displacement", "force_left", "force_right", "force_bottom", "force_top",
            "newton_iterations", "wall_s"]
 # fmt: on
-D4 = [np.array(m, float) for m in ([[1, 0], [0, 1]], [[0, -1], [1, 0]], [[-1, 0], [0, -1]],
-      [[0, 1], [-1, 0]], [[-1, 0], [0, 1]], [[1, 0], [0, -1]], [[0, 1], [1, 0]],
-      [[0, -1], [-1, 0]])]
+D4 = [
+    np.array(m, float)
+    for m in (
+        [[1, 0], [0, 1]],
+        [[0, -1], [1, 0]],
+        [[-1, 0], [0, -1]],
+        [[0, 1], [-1, 0]],
+        [[-1, 0], [0, 1]],
+        [[1, 0], [0, -1]],
+        [[0, 1], [1, 0]],
+        [[0, -1], [-1, 0]],
+    )
+]
 
 
 def parse(argv):
-    p = cli.demo_parser("nine_discs.py", __doc__, "results/nine_discs", OPTIONS, discretization=False)
+    p = cli.demo_parser(
+        "nine_discs.py", __doc__, "results/nine_discs", OPTIONS, discretization=False
+    )
     a = p.parse_args(argv)
     k = (3 * a.R + 1.0) / a.h
     if abs(k - round(k)) > 1e-9 * k or not 10 <= a.R / a.h <= 200:
@@ -65,20 +77,38 @@ def build(run):
     p = run.params
     grid, bodies, scene, faces = nine_discs(run.comm, R=p["R"], h=p["h"], overlap=p["overlap"])
     run.data["faces"] = faces
-    bcs = [Dirichlet(lambda x, a=axis, c=c: np.isclose(x[a], c, rtol=0, atol=1e-9 * abs(c)),
-                     axis, -np.sign(c) * p["displacement"]) for axis, c in faces.values()]
+    bcs = [
+        Dirichlet(
+            lambda x, a=axis, c=c: np.isclose(x[a], c, rtol=0, atol=1e-9 * abs(c)),
+            axis,
+            -np.sign(c) * p["displacement"],
+        )
+        for axis, c in faces.values()
+    ]
     return ImplicitMPM(
-        run.comm, grid, [MPMBody(n, t, (p["E"], p["nu"]), s) for n, t, s in bodies], scene,
-        dirichlet=bcs, mu=p["mu"], eps0=p["eps0"], timer=run.timer,
+        run.comm,
+        grid,
+        [MPMBody(n, t, (p["E"], p["nu"]), s) for n, t, s in bodies],
+        scene,
+        dirichlet=bcs,
+        mu=p["mu"],
+        eps0=p["eps0"],
+        timer=run.timer,
     )
 
 
 def row(run, rec):
     f = rec["body_forces"]
-    return dict(step=rec["step"], displacement=rec["step"] * run.params["displacement"],
-                force_left=-f["plate_left"][0], force_right=f["plate_right"][0],
-                force_bottom=-f["plate_bottom"][1], force_top=f["plate_top"][1],
-                newton_iterations=rec["newton_iterations"], wall_s=rec["wall_s"])
+    return dict(
+        step=rec["step"],
+        displacement=rec["step"] * run.params["displacement"],
+        force_left=-f["plate_left"][0],
+        force_right=f["plate_right"][0],
+        force_bottom=-f["plate_bottom"][1],
+        force_top=f["plate_top"][1],
+        newton_iterations=rec["newton_iterations"],
+        wall_s=rec["wall_s"],
+    )
 
 
 def symmetry_error(sim, rec):
@@ -115,16 +145,23 @@ def evaluate(run):
     e_f, e_s, e_x, frac = symmetry_error(sim, rec)
     forces = np.array([v[:2] for v in rec["body_forces"].values()])
     fmax = max(q["normal_force"] for q in rec["pairs"])
-    eq = max(  # contacts + supports (the plates' outer faces) on every body
-        np.hypot(*(np.add(rec["body_forces"][n][:2], rec["support_forces"][n])))
-        for n in rec["body_forces"]
-    ) / fmax
+    eq = (
+        max(  # contacts + supports (the plates' outer faces) on every body
+            np.hypot(*(np.add(rec["body_forces"][n][:2], rec["support_forces"][n])))
+            for n in rec["body_forces"]
+        )
+        / fmax
+    )
     run.results.update(
-        symmetry_force_rel=e_f, symmetry_stress_rel=e_s, symmetry_position_max=e_x,
+        symmetry_force_rel=e_f,
+        symmetry_stress_rel=e_s,
+        symmetry_position_max=e_x,
         symmetry_points_compared=frac,
-        equilibrium_rel=eq, newton_iterations=[r["newton_iterations"] for r in run.records],
+        equilibrium_rel=eq,
+        newton_iterations=[r["newton_iterations"] for r in run.records],
         contacts=len([q for q in rec["pairs"] if q["normal_force"] > 0]),
-        max_normal_force=fmax, plate_forces=forces[-4:].tolist(),
+        max_normal_force=fmax,
+        plate_forces=forces[-4:].tolist(),
     )
     warn = run.metrics["solver"]["warnings"]
     if max(e_f, e_s) > 1e-6:
@@ -139,16 +176,28 @@ def plots(run, folder):
 
 def summary(run):
     r = run.results
-    return (f"nine discs: {r['contacts']} contacts, largest normal force {r['max_normal_force']:.5g} "
-            f"N/mm; D4 symmetry: forces {r['symmetry_force_rel']:.1e}, stresses "
-            f"{r['symmetry_stress_rel']:.1e}; equilibrium {r['equilibrium_rel']:.1e}; "
-            f"Newton {r['newton_iterations']}")
+    return (
+        f"nine discs: {r['contacts']} contacts, largest normal force {r['max_normal_force']:.5g} "
+        f"N/mm; D4 symmetry: forces {r['symmetry_force_rel']:.1e}, stresses "
+        f"{r['symmetry_stress_rel']:.1e}; equilibrium {r['equilibrium_rel']:.1e}; "
+        f"Newton {r['newton_iterations']}"
+    )
 
 
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
-    return run_steps("nine_discs", vars(args), build, args.steps, row, COLUMNS,
-                     evaluate=evaluate, plots=plots, summary=summary, series_every=1)
+    return run_steps(
+        "nine_discs",
+        vars(args),
+        build,
+        args.steps,
+        row,
+        COLUMNS,
+        evaluate=evaluate,
+        plots=plots,
+        summary=summary,
+        series_every=1,
+    )
 
 
 if __name__ == "__main__":

@@ -99,7 +99,14 @@ class ContactSet:
             if g.obstacle is None or s is None:
                 continue
             F, M = contact_resultants(
-                g.obstacle, g.points, g.weights, g.normals, g.tangents, s["tau_n"], s["tau_t"], g.p_j
+                g.obstacle,
+                g.points,
+                g.weights,
+                g.normals,
+                g.tangents,
+                s["tau_n"],
+                s["tau_t"],
+                g.p_j,
             )
             F0, M0 = out[g.obstacle.name]
             out[g.obstacle.name] = (F0 + F, M0 + M)
@@ -109,7 +116,16 @@ class ContactSet:
         mu = self.mu if mu is None else mu
         gtp = self.history[k].committed if mu > 0 else _NONE
         return _cpp.assemble_contact(
-            self.pairs[k].quadrature, self.eps_n, self.eps_t, mu, u, gtp, b, A, fd, fd_step,
+            self.pairs[k].quadrature,
+            self.eps_n,
+            self.eps_t,
+            mu,
+            u,
+            gtp,
+            b,
+            A,
+            fd,
+            fd_step,
             closed_gap,
         )
 

@@ -100,7 +100,9 @@ def _canonical(scene, cells):
     g = scene.mesh.geometry.dofmap.array.reshape(-1, 4)[cells]
     x = scene.mesh.geometry.x[g][:, :, :2]
     lo, hi = x.min(axis=1), x.max(axis=1)
-    key = (x[:, :, 0] > 0.5 * (lo + hi)[:, None, 0]) + 2 * (x[:, :, 1] > 0.5 * (lo + hi)[:, None, 1])
+    key = (x[:, :, 0] > 0.5 * (lo + hi)[:, None, 0]) + 2 * (
+        x[:, :, 1] > 0.5 * (lo + hi)[:, None, 1]
+    )
     return lo, hi - lo, np.argsort(key, axis=1)
 
 

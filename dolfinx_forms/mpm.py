@@ -100,7 +100,9 @@ class ImplicitMPM:
         self.levelsets = {}
         for b in self.bodies:
             if isinstance(b.shape, _cpp.LevelSet):
-                self.levelsets[b.tag] = _cpp.LevelSet(self.grid, b.shape.evaluate(self.grid.nodes())[0])
+                self.levelsets[b.tag] = _cpp.LevelSet(
+                    self.grid, b.shape.evaluate(self.grid.nodes())[0]
+                )
             else:
                 self.levelsets[b.tag] = _cpp.levelset_from_shape(self.grid, b.shape)
         self.build_scene = build_scene
@@ -125,15 +127,21 @@ class ImplicitMPM:
         """Every piece of state a step changes (deep copies)."""
         return dict(
             points=None if self.points is None else {t: p.copy() for t, p in self.points.items()},
-            levelsets={t: _cpp.LevelSet(self.grid, l.values.ravel()) for t, l in self.levelsets.items()},
+            levelsets={
+                t: _cpp.LevelSet(self.grid, l.values.ravel()) for t, l in self.levelsets.items()
+            },
             obstacles=[ob.state() for ob in self.obstacles],
             friction={k: (x.copy(), e.copy()) for k, (x, e) in self.friction.items()},
             step_count=self.step_count,
         )
 
     def restore(self, snap):
-        self.points = None if snap["points"] is None else {t: p.copy() for t, p in snap["points"].items()}
-        self.levelsets = {t: _cpp.LevelSet(self.grid, l.values.ravel()) for t, l in snap["levelsets"].items()}
+        self.points = (
+            None if snap["points"] is None else {t: p.copy() for t, p in snap["points"].items()}
+        )
+        self.levelsets = {
+            t: _cpp.LevelSet(self.grid, l.values.ravel()) for t, l in snap["levelsets"].items()
+        }
         for ob, s in zip(self.obstacles, snap["obstacles"]):
             ob.set_state(s)
         self.friction = {k: (x.copy(), e.copy()) for k, (x, e) in snap["friction"].items()}
@@ -173,8 +181,10 @@ class ImplicitMPM:
         if sigma0 is not None:
             S = _stress_tensor(sigma0)
             loads.append(
-                Load(lambda v, measure: -ufl.inner(S, ufl.grad(v)) * measure(None, degree=mp.DEGREE),
-                     scale=lambda lam: 1.0)
+                Load(
+                    lambda v, measure: -ufl.inner(S, ufl.grad(v)) * measure(None, degree=mp.DEGREE),
+                    scale=lambda lam: 1.0,
+                )
             )
         kw = dict(self.problem_kw)
         kw.setdefault("pair_grid_origin", (self.xlines[0], self.ylines[0]))
@@ -270,7 +280,9 @@ class ImplicitMPM:
         """MLS projection of each body's point stress to the Gauss points (degree mp.DEGREE) of
         its cells: a `Quadrature` vector function [s_xx, s_yy, s_xy]."""
         mesh = scene.mesh
-        Qe = ufl.VectorElement("Quadrature", mesh.ufl_cell(), mp.DEGREE, dim=3, quad_scheme="default")
+        Qe = ufl.VectorElement(
+            "Quadrature", mesh.ufl_cell(), mp.DEGREE, dim=3, quad_scheme="default"
+        )
         sigma0 = fem.Function(fem.FunctionSpace(mesh, Qe), name="sigma0")
         qdofs = sigma0.function_space.dofmap.list.array.reshape(len(scene.cell_tags.values), -1)
         arr = sigma0.x.array.reshape(-1, 3)
@@ -358,7 +370,9 @@ class ImplicitMPM:
                     normal_force=float(np.sum(w * pn)),
                     tangential_force=float(np.sum(w * pt)),
                     active_length=float(np.sum(wa)),
-                    stick_fraction=float(np.sum(w[s["state"] == 1]) / np.sum(wa)) if active.any() else 0.0,
+                    stick_fraction=float(np.sum(w[s["state"] == 1]) / np.sum(wa))
+                    if active.any()
+                    else 0.0,
                     half_width=0.0 if xl is None else 0.5 * (xr - xl),
                     num_points=int(len(w)),
                 )
@@ -374,22 +388,32 @@ class ImplicitMPM:
         forces = {b.name: np.zeros(3) for b in self.bodies}
         for k, g in enumerate(cs.pairs):
             s = cs.committed[k]
-            f = (s["tau_n"][:, None] * g.normals + s["tau_t"][:, None] * g.tangents) * g.weights[:, None]
+            f = (s["tau_n"][:, None] * g.normals + s["tau_t"][:, None] * g.tangents) * g.weights[
+                :, None
+            ]
             for sign, name, p in ((1.0, keys[k][0], g.p_i), (-1.0, keys[k][1], g.p_j)):
                 if name in forces:
                     b = next(b for b in self.bodies if b.name == name)
                     c = np.average(self.points[b.tag].x, axis=0, weights=self.points[b.tag].vol)
                     r = p - c
                     forces[name] += sign * np.array(
-                        [f[:, 0].sum(), f[:, 1].sum(), np.sum(r[:, 0] * f[:, 1] - r[:, 1] * f[:, 0])]
+                        [
+                            f[:, 0].sum(),
+                            f[:, 1].sum(),
+                            np.sum(r[:, 0] * f[:, 1] - r[:, 1] * f[:, 0]),
+                        ]
                     )
-        body_forces = {n: allreduce_array(self.comm, v, MPI.SUM).tolist() for n, v in forces.items()}
+        body_forces = {
+            n: allreduce_array(self.comm, v, MPI.SUM).tolist() for n, v in forces.items()
+        }
         res = cs.obstacle_resultants()
         obstacles = {}
         for ob in self.obstacles:
             F, M = res[ob.name]
             F = allreduce_array(self.comm, np.asarray(F, float), MPI.SUM)
-            obstacles[ob.name] = dict(fx=float(F[0]), fy=float(F[1]), moment=self.comm.allreduce(M, op=MPI.SUM))
+            obstacles[ob.name] = dict(
+                fx=float(F[0]), fy=float(F[1]), moment=self.comm.allreduce(M, op=MPI.SUM)
+            )
         return dict(pairs=pairs, obstacles=obstacles, body_forces=body_forces)
 
     def _evolve(self, problem, scene):
@@ -435,7 +459,10 @@ class ImplicitMPM:
             values = phi.values  # (ny, nx) copy
             v = vel.reshape(ny, nx, 2)[win].reshape(-1, 2)
             v = _cpp.extend_normal(
-                sub, values[win].ravel(), known[win].ravel().astype(np.int8), np.ascontiguousarray(v)
+                sub,
+                values[win].ravel(),
+                known[win].ravel().astype(np.int8),
+                np.ascontiguousarray(v),
             )
             full = np.zeros((ny, nx, 2))
             full[win] = v.reshape(j1 - j0 + 1, i1 - i0 + 1, 2)

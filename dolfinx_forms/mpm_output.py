@@ -198,7 +198,9 @@ def run_steps(
             run.records.append(rec)
             run.rows.append(row(run, rec))
             if x0 is None:  # positions at seeding: the first step's points before it moved
-                x0 = {t: p.x - d for (t, p), d in zip(run.sim.points.items(), run.sim.first_step_du)}
+                x0 = {
+                    t: p.x - d for (t, p), d in zip(run.sim.points.items(), run.sim.first_step_du)
+                }
             if comm.rank == 0 and ((k + 1) % series_every == 0 or k + 1 == num_steps or k == 0):
                 add_frames(run.sim, points_series, grid_series, rec["step"], x0)
     except (ContactSolverError, RuntimeError) as e:  # Newton, or the geometry of a step
@@ -206,7 +208,9 @@ def run_steps(
             sys.stderr.write(f"{prog}: step {len(run.records) + 1}: {e}\n")
         return 1
     last = run.records[-1]
-    metrics["mesh"].update(h_contact=run.sim.h, num_cells=last["num_cells"], num_dofs=last["num_dofs"])
+    metrics["mesh"].update(
+        h_contact=run.sim.h, num_cells=last["num_cells"], num_dofs=last["num_dofs"]
+    )
     metrics["solver"].update(
         load_steps=len(run.records),
         newton_iterations=[r["newton_iterations"] for r in run.records],
@@ -220,12 +224,23 @@ def run_steps(
         evaluate(run)
     run.timer.stop()
     run.metrics = metrics = comm.bcast(metrics if comm.rank == 0 else None, root=0)
-    contacts = [dict(step=r["step"], **{c: p[c] for c in CONTACT_COLUMNS[1:]}) for r in run.records for p in r["pairs"]]
+    contacts = [
+        dict(step=r["step"], **{c: p[c] for c in CONTACT_COLUMNS[1:]})
+        for r in run.records
+        for p in r["pairs"]
+    ]
     bodies = [
-        dict(step=r["step"], body=b.name, fx=r["body_forces"][b.name][0], fy=r["body_forces"][b.name][1],
-             moment=r["body_forces"][b.name][2], area_levelset=r["area_levelset"][b.name],
-             volume_points=r["volume_points"][b.name])
-        for r in run.records for b in run.sim.bodies
+        dict(
+            step=r["step"],
+            body=b.name,
+            fx=r["body_forces"][b.name][0],
+            fy=r["body_forces"][b.name][1],
+            moment=r["body_forces"][b.name][2],
+            area_levelset=r["area_levelset"][b.name],
+            volume_points=r["volume_points"][b.name],
+        )
+        for r in run.records
+        for b in run.sim.bodies
     ]
     with atomic_output_dir(params["out"], comm, force=params.get("force", False)) as folder:
         folder = Path(folder)

@@ -46,14 +46,18 @@ def grain_assembly(comm, n=15, radius=5.0, h=0.5, aspect=1.25, overlap=None, mar
         return RigidObstacle(name, half_plane(point, normal, ext), bbox=box, center=center)
 
     plates = {
-        "plate_left": plate("plate_left", (lo[0], 0), (1, 0),
-                            [[lo[0] - far, -far], [lo[0], far]], (lo[0], lo[1])),
-        "plate_right": plate("plate_right", (hi[0], 0), (-1, 0),
-                             [[hi[0], -far], [hi[0] + far, far]], (hi[0], lo[1])),
-        "plate_bottom": plate("plate_bottom", (0, lo[1]), (0, 1),
-                              [[-far, lo[1] - far], [far, lo[1]]], (0, lo[1])),
-        "plate_top": plate("plate_top", (0, hi[1]), (0, -1),
-                           [[-far, hi[1]], [far, hi[1] + far]], (0, hi[1])),
+        "plate_left": plate(
+            "plate_left", (lo[0], 0), (1, 0), [[lo[0] - far, -far], [lo[0], far]], (lo[0], lo[1])
+        ),
+        "plate_right": plate(
+            "plate_right", (hi[0], 0), (-1, 0), [[hi[0], -far], [hi[0] + far, far]], (hi[0], lo[1])
+        ),
+        "plate_bottom": plate(
+            "plate_bottom", (0, lo[1]), (0, 1), [[-far, lo[1] - far], [far, lo[1]]], (0, lo[1])
+        ),
+        "plate_top": plate(
+            "plate_top", (0, hi[1]), (0, -1), [[-far, hi[1]], [far, hi[1] + far]], (0, hi[1])
+        ),
     }
     margin = 4 * h + 0.1 * radius if margin is None else margin
     ax = [uniform_lines(lo[d] - margin, hi[d] + margin, h) for d in range(2)]

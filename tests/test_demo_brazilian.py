@@ -30,8 +30,13 @@ def test_coarse_run_writes_the_contract(tmp_path):
         assert m["timing_s"][k] > 0
     with open(out / "contacts.csv") as f:
         assert next(csv.reader(f))[:3] == ["step", "body_i", "body_j"]
-    for f in ("bodies.csv", "half_width.png", "sigma_yy.png", "levelsets.xdmf",
-              "material_points_disc.xdmf"):
+    for f in (
+        "bodies.csv",
+        "half_width.png",
+        "sigma_yy.png",
+        "levelsets.xdmf",
+        "material_points_disc.xdmf",
+    ):
         assert (out / f).exists(), f
 
 

@@ -33,8 +33,12 @@ def test_compression_then_shear(tmp_path):
 
 @pytest.mark.parametrize(
     "args, word",
-    [(["--grains", "1"], "--grains"), (["--friction-angle", "0"], "--friction-angle"),
-     (["--compression", "1"], "--compression"), (["--h", "5"], "--h")],
+    [
+        (["--grains", "1"], "--grains"),
+        (["--friction-angle", "0"], "--friction-angle"),
+        (["--compression", "1"], "--compression"),
+        (["--h", "5"], "--h"),
+    ],
 )
 def test_bad_input(args, word, tmp_path, capsys):
     with pytest.raises(SystemExit) as e:

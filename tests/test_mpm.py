@@ -36,8 +36,12 @@ def test_rigid_translation_keeps_zero_stress_and_moves_points_exactly():
     bcs = [Dirichlet(everywhere, c, float(d[c])) for c in range(2)]
     body = MPMBody("disc", 1, (E, 0.3), df.Circle((0.0, 0.0), 0.77))
     sim = ImplicitMPM(
-        COMM, (lines, lines), [body], grid_scene(COMM, lines, lines, [("disc", 1)]),
-        dirichlet=bcs, **quiet
+        COMM,
+        (lines, lines),
+        [body],
+        grid_scene(COMM, lines, lines, [("disc", 1)]),
+        dirichlet=bcs,
+        **quiet,
     )
     rec = sim.step()
     pts = sim.points[1]
@@ -72,8 +76,13 @@ def test_block_between_frictionless_platens_gives_the_uniaxial_force():
     body = MPMBody("block", 1, (E, nu), df.Box((-10.0, -L), (10.0, L)))
     sym = Dirichlet(lambda x: np.isclose(x[0], 0.0), 0, 0.0)
     sim = ImplicitMPM(
-        COMM, (xl, yl), [body], grid_scene(COMM, xl, yl, [("block", 1)]),
-        obstacles=[top, bottom], dirichlet=[sym], **quiet
+        COMM,
+        (xl, yl),
+        [body],
+        grid_scene(COMM, xl, yl, [("block", 1)]),
+        obstacles=[top, bottom],
+        dirichlet=[sym],
+        **quiet,
     )
     for _ in range(10):
         rec = sim.step()
@@ -143,8 +152,11 @@ def test_obstacle_motion_and_pose():
     """The pose maps the frame shape; a step's displacement is a rigid motion about the
     current centre; advance() moves the pose by it."""
     ob = RigidObstacle(
-        "bar", df.Box((-1.0, -0.1), (1.0, 0.1)), bbox=[[-1, -0.1], [1, 0.1]],
-        translation=(0.2, -0.1), rotation=0.3,
+        "bar",
+        df.Box((-1.0, -0.1), (1.0, 0.1)),
+        bbox=[[-1, -0.1], [1, 0.1]],
+        translation=(0.2, -0.1),
+        rotation=0.3,
     )
     x = np.array([[1.0, 0.1], [-0.5, 0.0]])
     u = ob.step_displacement(x)
@@ -185,15 +197,24 @@ def test_disc_column_carries_the_load_through_every_contact():
 
     grid, bodies, platens, build = disc_column(COMM, 3, 10.0, 0.5, 0.1, 3)
     sim = ImplicitMPM(
-        COMM, grid, [MPMBody(n, t, (100e3, 0.3), s) for n, t, s in bodies], build,
-        obstacles=platens, dirichlet=[Dirichlet(lambda x: np.isclose(x[0], 0.0), 0, 0.0)],
-        eps0=0.3, **quiet,
+        COMM,
+        grid,
+        [MPMBody(n, t, (100e3, 0.3), s) for n, t, s in bodies],
+        build,
+        obstacles=platens,
+        dirichlet=[Dirichlet(lambda x: np.isclose(x[0], 0.0), 0, 0.0)],
+        eps0=0.3,
+        **quiet,
     )
     for _ in range(3):
         rec = sim.step()
         keys = sorted((p["body_i"], p["body_j"]) for p in rec["pairs"])
-        assert keys == [("disc0", "disc1"), ("disc0", "platen_bottom"), ("disc1", "disc2"),
-                        ("disc2", "platen_top")]
+        assert keys == [
+            ("disc0", "disc1"),
+            ("disc0", "platen_bottom"),
+            ("disc1", "disc2"),
+            ("disc2", "platen_top"),
+        ]
         F = np.array([abs(p["fy"]) for p in rec["pairs"]])
         assert np.ptp(F) <= 1e-6 * F.max()
         for name, f in rec["body_forces"].items():  # contacts + the symmetry line's support
@@ -211,12 +232,22 @@ def test_hexagonal_assembly_of_ellipses_in_rigid_plates():
 
     grid, bodies, plates, build, box, _ = grain_assembly(COMM, 15, h=0.5, aspect=1.1, overlap=0.01)
     d = 0.01
-    for name, v in (("plate_left", (d, 0)), ("plate_right", (-d, 0)),
-                    ("plate_bottom", (0, d)), ("plate_top", (0, -d))):
+    for name, v in (
+        ("plate_left", (d, 0)),
+        ("plate_right", (-d, 0)),
+        ("plate_bottom", (0, d)),
+        ("plate_top", (0, -d)),
+    ):
         plates[name].translation = np.array(v)
     sim = ImplicitMPM(
-        COMM, grid, [MPMBody(n, t, (100e3, 0.2), s) for n, t, s in bodies], build,
-        obstacles=list(plates.values()), mu=np.tan(np.radians(15)), predictor_gap=0.25, **quiet,
+        COMM,
+        grid,
+        [MPMBody(n, t, (100e3, 0.2), s) for n, t, s in bodies],
+        build,
+        obstacles=list(plates.values()),
+        mu=np.tan(np.radians(15)),
+        predictor_gap=0.25,
+        **quiet,
     )
     for _ in range(2):
         rec = sim.step()
@@ -225,7 +256,9 @@ def test_hexagonal_assembly_of_ellipses_in_rigid_plates():
         assert np.hypot(f[0], f[1]) <= 1e-8 * fmax, name
     ob = rec["obstacles"]  # the plates' forces balance (friction on them included)
     assert np.hypot(*np.sum([[o["fx"], o["fy"]] for o in ob.values()], axis=0)) <= 1e-8 * fmax
-    assert ob["plate_top"]["fy"] > 0 and len([p for p in rec["pairs"] if p["normal_force"] > 0]) >= 30
+    assert (
+        ob["plate_top"]["fy"] > 0 and len([p for p in rec["pairs"] if p["normal_force"] > 0]) >= 30
+    )
 
 
 def test_mesh_kept_when_active_cells_do_not_change():
@@ -241,9 +274,13 @@ def test_mesh_kept_when_active_cells_do_not_change():
         )
         bottom = RigidObstacle("bottom", half_plane((0, -L), (0, 1), 100), bbox=[[-2, -2], [2, -L]])
         return ImplicitMPM(
-            COMM, (xl, yl), [MPMBody("block", 1, (1000.0, 0.3), df.Box((-10.0, -L), (10.0, L)))],
-            grid_scene(COMM, xl, yl, [("block", 1)]), obstacles=[top, bottom],
-            dirichlet=[Dirichlet(lambda x: np.isclose(x[0], 0.0), 0, 0.0)], **quiet,
+            COMM,
+            (xl, yl),
+            [MPMBody("block", 1, (1000.0, 0.3), df.Box((-10.0, -L), (10.0, L)))],
+            grid_scene(COMM, xl, yl, [("block", 1)]),
+            obstacles=[top, bottom],
+            dirichlet=[Dirichlet(lambda x: np.isclose(x[0], 0.0), 0, 0.0)],
+            **quiet,
         )
 
     a, b = sim(), sim()

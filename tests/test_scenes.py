@@ -259,6 +259,9 @@ def test_patch_scene_two_ranks():
 def test_point_condition_off_the_mesh_names_the_nearest_vertex():
     from dolfinx_forms import run
 
-    with pytest.raises(SpecError, match=r"dirichlet\[2\]\.point: \[0\.01, 0\.0\] is not a mesh "
-                                        r"vertex \(the nearest is \[0\.0, 0\.0\]\)"):
+    with pytest.raises(
+        SpecError,
+        match=r"dirichlet\[2\]\.point: \[0\.01, 0\.0\] is not a mesh "
+        r"vertex \(the nearest is \[0\.0, 0\.0\]\)",
+    ):
         run(SCENES / "patch.toml", write=False, overrides=["dirichlet[2].point=[0.01, 0.0]"])
