@@ -395,6 +395,17 @@ def pack_grains(outlines, box, gap=0.0, rng=None, max_tries=1000, wall_gap=None)
     return placed
 
 
+def lattice_boxes(n, rng):
+    """(n, 2, 2) bounding boxes of grains of radius 0.35-0.5 on a jittered unit lattice in a
+    square, in random order: the broad phase's test and benchmark input (n a square)."""
+    m = int(round(np.sqrt(n)))
+    ij = np.stack(np.meshgrid(np.arange(m), np.arange(m)), -1).reshape(-1, 2).astype(float)
+    c = ij + rng.uniform(-0.05, 0.05, size=ij.shape)
+    r = rng.uniform(0.35, 0.5, size=(len(c), 1))
+    b = np.stack([c - r, c + r], axis=1)
+    return b[rng.permutation(len(b))]
+
+
 def _main(argv=None):
     import argparse
     import time

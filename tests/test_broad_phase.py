@@ -6,11 +6,11 @@ boxes), touching counts, empty and bad input, and a timing measurement on grain 
 Run the timing table alone: /usr/bin/python3 tests/test_broad_phase.py
 """
 
-import time
 
 import numpy as np
 import pytest
 from dolfinx_forms import _cpp
+from meshes.grains import lattice_boxes
 
 
 def brute_force(boxes, inflate=0.0):
@@ -135,47 +135,12 @@ def test_bad_input(call, match):
         call()
 
 
-def grain_boxes(n, rng):
-    """Bounding boxes of n grains (radius 0.35-0.5, gap >= 0 between discs of radius <= 0.45
-    mostly) on a jittered unit lattice in a square box, in random order."""
-    m = int(round(np.sqrt(n)))
-    ij = np.stack(np.meshgrid(np.arange(m), np.arange(m)), -1).reshape(-1, 2).astype(float)
-    c = ij + rng.uniform(-0.05, 0.05, size=ij.shape)
-    r = rng.uniform(0.35, 0.5, size=(len(c), 1))
-    b = np.stack([c - r, c + r], axis=1)
-    return b[rng.permutation(len(b))]
-
-
-def timing_table(sizes=(25, 100, 400, 1600, 6400), repeats=30):
+def test_grain_packing_matches_reference():
+    """Jittered lattices of grain boxes (benchmarks/broad_phase.py times them): pairs equal the
+    reference up to N = 1600, and pairs <= 4 N (each grain meets at most its 8 neighbours)."""
     rng = np.random.default_rng(0)
-    rows = []
-    for n in sizes:
-        b = grain_boxes(n, rng)
-        times = []
-        for _ in range(repeats):
-            t0 = time.perf_counter()
-            p = _cpp.candidate_pairs(b, 0.02)
-            times.append(time.perf_counter() - t0)
-        rows.append((n, len(p), min(times), float(np.median(times)), b, p))
-    return rows
-
-
-def test_timing_grain_packing():
-    """Benchmark-style: prints N, pairs, min and median time and time per grain. Asserts only
-    correctness (pairs equal the reference up to N = 1600) and pairs <= 4 N (each grain meets at
-    most its 8 lattice neighbours)."""
-    rows = timing_table()
-    print("\n    N   pairs   min [us]  median [us]  min/N [us]")
-    for n, npairs, tmin, tmed, b, p in rows:
-        print(f"{n:5d} {npairs:7d} {1e6 * tmin:10.1f} {1e6 * tmed:12.1f} {1e6 * tmin / n:11.3f}")
-        assert npairs <= 4 * n
-        if n <= 1600:
-            np.testing.assert_array_equal(p, brute_force(b, 0.02))
-
-
-if __name__ == "__main__":
-    for n, npairs, tmin, tmed, _, _ in timing_table():
-        print(
-            f"N={n:5d} pairs={npairs:6d} min={1e6 * tmin:9.1f} us median={1e6 * tmed:9.1f} us"
-            f" per grain={1e6 * tmin / n:.3f} us"
-        )
+    for n in (25, 100, 400, 1600):
+        b = lattice_boxes(n, rng)
+        p = _cpp.candidate_pairs(b, 0.02)
+        assert len(p) <= 4 * n
+        np.testing.assert_array_equal(p, brute_force(b, 0.02))
