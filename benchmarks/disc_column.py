@@ -27,7 +27,7 @@ ap.add_argument("--R", type=float, default=10.0)
 ap.add_argument("--h", type=float, default=0.25)
 ap.add_argument("--step", type=float, default=0.05)
 ap.add_argument("--steps", type=int, default=80)
-ap.add_argument("--eps0", type=float, default=0.3)
+ap.add_argument("--eps0", type=float, default=0.2)
 ap.add_argument("--out", default="benchmarks/results")
 a = ap.parse_args()
 E, nu = 100e3, 0.3
