@@ -159,6 +159,9 @@ class GridLocator:
 
     def locate(self, points, max_distance):
         p = np.asarray(points, float)[:, :2]
+        if len(self.cells) == 0:  # none of the body's cells on this rank (owned_only)
+            n = len(p)
+            return np.full(n, -1, np.int32), np.full((n, 2), np.nan), np.full(n, np.inf)
         i, j = self._index(p)
         best = np.full(len(p), -1, np.int32)
         dist = np.full(len(p), np.inf)

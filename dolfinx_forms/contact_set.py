@@ -18,8 +18,14 @@ STATE_NAMES = {0: "open", 1: "stick", 2: "slip"}
 _NONE = np.zeros(0)
 
 
+def pair_key(pair, obstacle=None):
+    """The key of a pair in a rank map: (i, j) for bodies, (i, obstacle name) for an obstacle."""
+    return (int(pair[0]), obstacle.name) if obstacle is not None else (int(pair[0]), int(pair[1]))
+
+
 class ContactSet:
-    """Contact points of `scene.pairs` on rank `rank` (empty elsewhere), penalty eps_n, eps_t
+    """Contact points of `scene.pairs` on rank `rank` (empty elsewhere; or a {pair_key: rank}
+    map: each pair on its own rank, the others on rank 0), penalty eps_n, eps_t
     (eq 51) and friction coefficient mu (0: frictionless, no history). obstacles:
     `obstacles.RigidObstacle`s, each paired with every body it may touch (its `bodies`); their
     prescribed motion at load level lam is set by `set_load`."""
@@ -41,18 +47,25 @@ class ContactSet:
         self.eps_n, self.eps_t, self.mu = float(eps_n), float(eps_t), float(mu)
         self.pairs = []
         self.obstacles = list(obstacles)
-        if V.mesh.comm.rank == rank:
-            kw = dict(grid_refine=grid_refine, num_gauss=num_gauss, lattice_origin=lattice_origin)
-            candidates = [(pair, None) for pair in scene.pairs] + [
-                ((i, -1), ob)
-                for ob in self.obstacles
-                for i, b in enumerate(scene.bodies)
-                if ob.bodies is None or b.tag in np.atleast_1d(ob.bodies)
-            ]
-            for pair, ob in candidates:
-                g = pair_geometry(V, scene, pair, band, obstacle=ob, **kw)
-                if g is not None:
-                    self.pairs.append(g)
+
+        # rank: the rank that computes every pair, or {pair key: rank} (pair_key; others on 0)
+        def owner(key):
+            return rank.get(key, 0) if isinstance(rank, dict) else rank
+
+        me = V.mesh.comm.rank
+        kw = dict(grid_refine=grid_refine, num_gauss=num_gauss, lattice_origin=lattice_origin)
+        candidates = [(tuple(pair), None) for pair in scene.pairs] + [
+            ((i, -1), ob)
+            for ob in self.obstacles
+            for i, b in enumerate(scene.bodies)
+            if ob.bodies is None or b.tag in np.atleast_1d(ob.bodies)
+        ]
+        for pair, ob in candidates:
+            if owner(pair_key(pair, ob)) != me:
+                continue
+            g = pair_geometry(V, scene, pair, band, obstacle=ob, **kw)
+            if g is not None:
+                self.pairs.append(g)
         self._lam = None
         self.history = [_cpp.FrictionHistory(len(g.weights), 1) for g in self.pairs]
         self.slip_start = [np.zeros(len(g.weights)) for g in self.pairs]

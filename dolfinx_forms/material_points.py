@@ -160,16 +160,18 @@ def displacement_at(problem, tag, points, max_distance):
             "an active cell of its body (the level set and the points have parted)"
         )
     take = np.flatnonzero(chosen == comm.rank)
-    tab = loc.element.tabulate(1, X[take])  # (3, n, 4, 1): value, d/dX, d/dY
-    dofs = V.dofmap.list.array.reshape(-1, 4)[cells[take]]
-    uloc = problem.u.x.array.reshape(-1, 2)[dofs]  # (n, 4, 2)
-    _, e = _cell_frames(scene, cells[take])
     val = np.zeros((len(points), 6))
-    val[take, :2] = np.einsum("na,nac->nc", tab[0, :, :, 0], uloc)
-    # d/dx_d = d/dX_d / h_d on axis-aligned cells; columns 2.. = du_x/dx, du_x/dy, du_y/dx, du_y/dy
-    gx = np.einsum("na,nac->nc", tab[1, :, :, 0], uloc) / e[:, :1]
-    gy = np.einsum("na,nac->nc", tab[2, :, :, 0], uloc) / e[:, 1:]
-    val[take, 2:] = np.stack([gx[:, 0], gy[:, 0], gx[:, 1], gy[:, 1]], axis=1)
+    if len(take):  # (basix aborts on an empty point set)
+        tab = loc.element.tabulate(1, X[take])  # (3, n, 4, 1): value, d/dX, d/dY
+        dofs = V.dofmap.list.array.reshape(-1, 4)[cells[take]]
+        uloc = problem.u.x.array.reshape(-1, 2)[dofs]  # (n, 4, 2)
+        _, e = _cell_frames(scene, cells[take])
+        val[take, :2] = np.einsum("na,nac->nc", tab[0, :, :, 0], uloc)
+        # d/dx_d = d/dX_d / h_d on axis-aligned cells; columns 2..: du_x/dx, du_x/dy, du_y/dx,
+        # du_y/dy
+        gx = np.einsum("na,nac->nc", tab[1, :, :, 0], uloc) / e[:, :1]
+        gy = np.einsum("na,nac->nc", tab[2, :, :, 0], uloc) / e[:, 1:]
+        val[take, 2:] = np.stack([gx[:, 0], gy[:, 0], gx[:, 1], gy[:, 1]], axis=1)
     val = allreduce_array(comm, val, MPI.SUM)
     grad = val[:, 2:].reshape(-1, 2, 2)  # grad[:, c, d] = du_c / dx_d
     n_out = comm.allreduce(int(np.sum(outside[take] > 0)), op=MPI.SUM)

@@ -162,10 +162,13 @@ class ImplicitMPM:
         t0 = time.perf_counter()
         with self.phase("mesh"):
             pairs = self.candidate_pairs()
+            ranks, contact_boxes = self.contact_ranks(pairs)
             key, boxes = self._scene_key(pairs)
+            if contact_boxes is not None:
+                key += [contact_boxes["boxes"].tobytes(), contact_boxes["owners"].tobytes()]
             rebuilt = self.scene is None or key != self._key
             if rebuilt:
-                scene = self.build_scene(dict(self.levelsets), pairs)
+                scene = self.build_scene(dict(self.levelsets), pairs, contact_boxes)
             else:  # same active cells, kinds and pairs: the mesh and its tags stay
                 scene = self.scene
                 for body, b, box in zip(scene.bodies, self.bodies, boxes):
@@ -188,6 +191,8 @@ class ImplicitMPM:
             )
         kw = dict(self.problem_kw)
         kw.setdefault("pair_grid_origin", (self.xlines[0], self.ylines[0]))
+        if ranks is not None:
+            kw["contact_rank"] = ranks
         problem = ContactProblem(
             scene,
             self.laws,
@@ -265,6 +270,54 @@ class ImplicitMPM:
             key += [g["active"].tobytes(), g["kinds"].tobytes()]
             boxes.append(g["bbox"])
         return key, boxes
+
+    def contact_ranks(self, pairs):
+        """In parallel: the box of each pair's contact region (grid nodes within the band of
+        both bodies, grown by the band and 2 h: Gamma_c and its closest points lie inside) and
+        the rank that computes it. Pairs go to ranks in contiguous groups along the domain's
+        longest axis; pairs whose boxes touch share a rank (the partitioner gives each box's
+        cells to its rank). Returns ({pair_key: rank}, {"boxes", "owners"}) or (None, None)
+        on one rank."""
+        size = self.comm.size
+        if size == 1:
+            return None, None
+        band = self.problem_kw.get("band") or 2 * self.h
+        X, Y = np.meshgrid(self.xlines, self.ylines)
+        P = np.stack([X.ravel(), Y.ravel()], axis=1)
+        near = {b.tag: self.levelsets[b.tag].values.ravel() < band for b in self.bodies}
+        keys, boxes = [], []
+
+        def add(key, mask):
+            if mask.any():
+                q = P[mask]
+                grow = band + 2 * self.h
+                keys.append(key)
+                boxes.append([q.min(axis=0) - grow, q.max(axis=0) + grow])
+
+        for i, j in pairs:
+            add((i, j), near[self.bodies[i].tag] & near[self.bodies[j].tag])
+        for ob in self.obstacles:
+            for i, b in enumerate(self.bodies):
+                if ob.bodies is None or b.tag in np.atleast_1d(ob.bodies):
+                    m = near[b.tag].copy()
+                    m[m] = ob.values(P[m]) < band
+                    add((i, ob.name), m)
+        if not keys:
+            return None, None
+        boxes = np.array(boxes)
+        axis = int(np.argmax(np.ptp(P, axis=0)))
+        order = np.argsort(0.5 * (boxes[:, 0, axis] + boxes[:, 1, axis]), kind="stable")
+        owners = np.empty(len(keys), np.int32)
+        owners[order] = (np.arange(len(keys)) * size) // len(keys)
+        lo, hi = boxes[:, 0], boxes[:, 1]
+        touch = np.all((lo[:, None] <= hi[None]) & (hi[:, None] >= lo[None]), axis=2)
+        while True:  # touching boxes take the smaller rank, until nothing changes
+            merged = np.where(touch, owners[None, :], size).min(axis=1).astype(np.int32)
+            if np.array_equal(merged, owners):
+                break
+            owners = merged
+        ranks = {k: int(r) for k, r in zip(keys, owners)}
+        return ranks, {"boxes": boxes, "owners": owners}
 
     def candidate_pairs(self):
         """Body pairs whose boxes, inflated by the contact band (and the level-set grid of the

@@ -23,9 +23,11 @@ def uniform_lines(lo, hi, h):
 
 
 def grid_scene(comm, xlines, ylines, bodies, pairs=(), boundary_markers=None, contact_box=None):
-    """build_scene(levelsets {tag: _cpp.LevelSet}, pairs=None) -> Scene for `bodies`
+    """build_scene(levelsets {tag: _cpp.LevelSet}, pairs=None, boxes=None) -> Scene for `bodies`
     [(name, tag)] on the grid; pairs: body-body contact pairs (indices into bodies; the
-    simulation passes its broad phase's each step, else these); boundary_markers: as in
+    simulation passes its broad phase's each step, else these); boxes: the simulation's contact
+    boxes with their ranks ({"boxes", "owners"}, meshes.scene.contact_partitioner), else
+    contact_box; boundary_markers: as in
     meshes.cut.cut_scene (default none); contact_box: the cells kept on rank 0 where contact is
     computed ((2, 2) or (k, 2, 2); None: from the pairs; required with obstacles in parallel)."""
     xlines, ylines = np.asarray(xlines, float), np.asarray(ylines, float)
@@ -33,10 +35,11 @@ def grid_scene(comm, xlines, ylines, bodies, pairs=(), boundary_markers=None, co
     h = float(max(np.diff(xlines).max(), np.diff(ylines).max()))
     fixed = list(pairs)
 
-    def build(levelsets, pairs=None):
+    def build(levelsets, pairs=None, boxes=None):
         cbodies = [CutBody(name, tag, window, levelsets[tag]) for name, tag in bodies]
         use = fixed if pairs is None else [tuple(p) for p in pairs]
-        return cut_scene(comm, xlines, ylines, cbodies, boundary_markers or {}, use, h, contact_box)
+        box = contact_box if boxes is None else boxes
+        return cut_scene(comm, xlines, ylines, cbodies, boundary_markers or {}, use, h, box)
 
     return build
 

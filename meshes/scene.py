@@ -255,11 +255,18 @@ def contact_partitioner(x: np.ndarray, cells: np.ndarray, cell_name: str, contac
     elsewhere); the partitioner receives the cells in that order. Cells whose vertex bbox
     intersects `contact_box` ((2, 2), or (k, 2, 2): a union of boxes) go to rank 0, topped up
     with the cells nearest to the box up to an equal share; the rest is cut into equal chunks
-    along the longest axis of the bounding box for ranks 1..nparts-1. GhostMode.none: one
+    along the longest axis of the bounding box for ranks 1..nparts-1. With contact_box a dict
+    {"boxes": (k, 2, 2), "owners": (k,)} each box's cells go to its owner instead (contact
+    computed by pair on several ranks) and the rest fills the ranks up to equal shares.
+    GhostMode.none: one
     destination per cell; shared_facet (and shared_vertex, treated alike): owner first, then
     the owners of its edge neighbours (the ranks that must hold it as a ghost). If the box
     holds more than 1/nparts of the cells, rank 0 simply gets more than its share.
     """
+    owners = None
+    if isinstance(contact_box, dict):  # {"boxes": (k, 2, 2), "owners": (k,)}: one rank per box
+        owners = np.asarray(contact_box["owners"], np.int32)
+        contact_box = contact_box["boxes"]
     boxes = np.asarray(contact_box, dtype=float).reshape(-1, 2, 2)
     AdjacencyList_int32 = dolfinx.cpp.graph.AdjacencyList_int32
 
@@ -269,7 +276,23 @@ def contact_partitioner(x: np.ndarray, cells: np.ndarray, cell_name: str, contac
             return AdjacencyList_int32(np.zeros(0, np.int32), np.zeros(1, np.int32))
         assert n == len(cells), "partitioner got cells other than the ones passed to create_mesh"
         owner = np.zeros(n, np.int32)
-        if nparts > 1:
+        if nparts > 1 and owners is not None:
+            # each box's cells to its owner (the first box that hits a cell wins); the rest,
+            # sorted along the longest axis, fills every rank up to an equal share
+            lo, hi = cell_bboxes(x, cells)
+            centroid = 0.5 * (lo + hi)
+            owner[:] = -1
+            for box, r in zip(boxes[::-1], owners[::-1] % nparts):
+                owner[np.all((lo <= box[1]) & (hi >= box[0]), axis=1)] = r
+            rest = np.flatnonzero(owner < 0)
+            axis = int(np.argmax(np.ptp(centroid, axis=0)))
+            rest = rest[np.argsort(centroid[rest, axis], kind="stable")]
+            need = np.maximum(0, -(-n // nparts) - np.bincount(owner[owner >= 0], minlength=nparts))
+            take = np.minimum(np.cumsum(need), len(rest))
+            for r, (a, b) in enumerate(zip(np.concatenate([[0], take[:-1]]), take)):
+                owner[rest[a:b]] = r
+            owner[rest[take[-1] :]] = nparts - 1
+        elif nparts > 1:
             lo, hi = cell_bboxes(x, cells)
             centroid = 0.5 * (lo + hi)
             hit = np.zeros(n, bool)

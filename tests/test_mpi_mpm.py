@@ -40,3 +40,55 @@ def test_brazilian_disc_two_ranks_match_one():
     assert np.max(np.abs(p.stress[op] - s.stress[os_])) <= 1e-8 * scale
     diff = np.abs(par.levelsets[1].values - ser.levelsets[1].values)
     assert np.max(diff) <= 1e-8 * par.h
+
+
+def assembly(comm, steps=2, mu=np.tan(np.radians(15))):
+    from test_mpm import quiet
+
+    from dolfinx_forms.mpm import ImplicitMPM, MPMBody
+    from meshes.assembly import grain_assembly
+
+    grid, bodies, plates, build, _, _ = grain_assembly(comm, 9, h=0.5, aspect=1.1, overlap=0.01)
+    for name, v in (
+        ("plate_left", (0.01, 0)),
+        ("plate_right", (-0.01, 0)),
+        ("plate_bottom", (0, 0.01)),
+        ("plate_top", (0, -0.01)),
+    ):
+        plates[name].translation = np.array(v)
+    sim = ImplicitMPM(
+        comm,
+        grid,
+        [MPMBody(n, t, (100e3, 0.2), s) for n, t, s in bodies],
+        build,
+        obstacles=list(plates.values()),
+        mu=mu,
+        predictor_gap=0.25,
+        newton=NewtonOptions(rtol=1e-13),
+        **quiet,
+    )
+    return sim, [sim.step() for _ in range(steps)]
+
+
+@pytest.mark.mpi
+def test_assembly_contact_by_pair_on_two_ranks_matches_one():
+    """Nine grains in rigid plates, frictionless: on 2 ranks each pair's contact is computed on
+    the rank that owns its cells (both ranks hold pairs); plate forces and pair forces agree
+    with one rank to 1e-8 over two steps."""
+    # frictionless: with mu = tan 15 deg the first step agrees to 1e-14 but the second by 2e-4
+    # (10 against 7 Newton iterations; not resolved, see docs/demos.md)
+    par, rp = assembly(MPI.COMM_WORLD, mu=0.0)
+    ser, rs = assembly(MPI.COMM_SELF, mu=0.0)
+    held = MPI.COMM_WORLD.allgather(len(par.problem.contact.pairs))
+    assert min(held) > 0, held
+    for a, b in zip(rp, rs):  # (Newton counts may differ in the round-off tail of rtol 1e-13)
+        for ob in a["obstacles"]:
+            for c in ("fx", "fy"):
+                assert a["obstacles"][ob][c] == pytest.approx(
+                    b["obstacles"][ob][c], rel=1e-8, abs=1e-8
+                )
+        fa = {(p["body_i"], p["body_j"]): p["normal_force"] for p in a["pairs"]}
+        fb = {(p["body_i"], p["body_j"]): p["normal_force"] for p in b["pairs"]}
+        assert fa.keys() == fb.keys()
+        scale = max(fb.values())
+        assert max(abs(fa[k] - fb[k]) for k in fa) <= 1e-8 * scale
