@@ -273,7 +273,7 @@ class ImplicitMPM:
 
     def contact_ranks(self, pairs):
         """In parallel: the box of each pair's contact region (grid nodes within the band of
-        both bodies, grown by the band and 2 h: Gamma_c and its closest points lie inside) and
+        both bodies, grown by the band and 2 h: Gamma_c, its closest points and their cells lie inside) and
         the rank that computes it. Pairs go to ranks in contiguous groups along the domain's
         longest axis; pairs whose boxes touch share a rank (the partitioner gives each box's
         cells to its rank). Returns ({pair_key: rank}, {"boxes", "owners"}) or (None, None)
@@ -290,7 +290,7 @@ class ImplicitMPM:
         def add(key, mask):
             if mask.any():
                 q = P[mask]
-                grow = band + 2 * self.h
+                grow = 2 * self.h  # P_i, P_j lie within band / 2 of Gamma_c: their cells in here
                 keys.append(key)
                 boxes.append([q.min(axis=0) - grow, q.max(axis=0) + grow])
 
