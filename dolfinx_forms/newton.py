@@ -74,12 +74,11 @@ def newton(problem, lam):
             stalled = it >= 2 and r > 0.5 * residuals[-2]
             if stalled and r <= 1e3 * opts.rtol * r0 and dnorm <= 1e-8 * max(unorm, 1e-300):
                 return True, residuals, ""
-        # An active set seen before without a lower residual: Newton is cycling. The
-        # states live on the contact rank only: the decision must be collective.
-        sig = problem.contact.signature()
-        cycling = problem.comm.allreduce(
-            bool(sig) and sig in seen and r >= 0.999 * seen[sig], op=MPI.LOR
-        )
+        # An active set seen before without a lower residual: Newton is cycling. The states
+        # live on the ranks that hold the pairs: the set compared is the union over the ranks
+        # (one rank's part can repeat while another's changes).
+        sig = tuple(problem.comm.allgather(problem.contact.signature()))
+        cycling = any(sig) and sig in seen and r >= 0.999 * seen[sig]
         if cycling:
             return False, residuals, f"active set cycles (iteration {it})"
         seen[sig] = min(r, seen.get(sig, np.inf))
