@@ -24,10 +24,10 @@ import sys
 import numpy as np
 
 from dolfinx_forms import cli
-from dolfinx_forms.boundary import Dirichlet
-from dolfinx_forms.mpm import ImplicitMPM, MPMBody
+from dolfinx_forms.mpm import ImplicitMPM, MPMBody, equilibrium_error
 from dolfinx_forms.mpm_output import plot_force_chains, run_steps
 from meshes.four_grains import check_contact_zones, four_grains, grain_outlines
+from meshes.mpm import plate_face_conditions
 
 # fmt: off
 OPTIONS = [  # option, kind, default[, help]
@@ -87,15 +87,7 @@ def build(run):
         outlines=run.data["outlines"],
     )
     run.data["faces"] = faces
-    # one component per plate: the outer face moves inward, its tangential motion is free
-    bcs = [
-        Dirichlet(
-            lambda x, a=axis, c=c: np.isclose(x[a], c, rtol=0, atol=1e-9 * abs(c)),
-            axis,
-            -np.sign(c) * p["displacement"],
-        )
-        for axis, c in faces.values()
-    ]
+    bcs = plate_face_conditions(faces, p["displacement"])
     return ImplicitMPM(
         run.comm,
         grid,
@@ -133,13 +125,7 @@ def evaluate(run):
     rec = run.records[-1]
     act = active(rec)
     fmax = max(q["normal_force"] for q in act)
-    eq = (
-        max(  # contacts + supports (the plates' outer faces) on every body
-            np.hypot(*(np.add(rec["body_forces"][n][:2], rec["support_forces"][n])))
-            for n in rec["body_forces"]
-        )
-        / fmax
-    )
+    eq = equilibrium_error(rec)  # contacts + supports (the plates' outer faces)
     per_grain = {g: sum(g in (q["body_i"], q["body_j"]) for q in act) for g in GRAINS}
     stick = {f"{q['body_i']}-{q['body_j']}": q["stick_fraction"] for q in act}
     f = rec["body_forces"]

@@ -23,10 +23,9 @@ import sys
 import numpy as np
 
 from dolfinx_forms import cli
-from dolfinx_forms.boundary import Dirichlet
-from dolfinx_forms.mpm import ImplicitMPM, MPMBody
+from dolfinx_forms.mpm import ImplicitMPM, MPMBody, equilibrium_error
 from dolfinx_forms.mpm_output import plot_force_chains, run_steps
-from meshes.mpm import nine_discs
+from meshes.mpm import nine_discs, plate_face_conditions
 
 # fmt: off
 OPTIONS = [  # option, kind, default[, help]
@@ -77,14 +76,7 @@ def build(run):
     p = run.params
     grid, bodies, scene, faces = nine_discs(run.comm, R=p["R"], h=p["h"], overlap=p["overlap"])
     run.data["faces"] = faces
-    bcs = [
-        Dirichlet(
-            lambda x, a=axis, c=c: np.isclose(x[a], c, rtol=0, atol=1e-9 * abs(c)),
-            axis,
-            -np.sign(c) * p["displacement"],
-        )
-        for axis, c in faces.values()
-    ]
+    bcs = plate_face_conditions(faces, p["displacement"])
     return ImplicitMPM(
         run.comm,
         grid,
@@ -145,13 +137,7 @@ def evaluate(run):
     e_f, e_s, e_x, frac = symmetry_error(sim, rec)
     forces = np.array([v[:2] for v in rec["body_forces"].values()])
     fmax = max(q["normal_force"] for q in rec["pairs"])
-    eq = (
-        max(  # contacts + supports (the plates' outer faces) on every body
-            np.hypot(*(np.add(rec["body_forces"][n][:2], rec["support_forces"][n])))
-            for n in rec["body_forces"]
-        )
-        / fmax
-    )
+    eq = equilibrium_error(rec)  # contacts + supports (the plates' outer faces)
     run.results.update(
         symmetry_force_rel=e_f,
         symmetry_stress_rel=e_s,

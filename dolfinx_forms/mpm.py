@@ -60,6 +60,16 @@ class MPMBody:
     shape: object
 
 
+def equilibrium_error(record):
+    """Largest |contact + support resultant| over the bodies of a step record, relative to the
+    largest normal contact force: every body's equilibrium in one number."""
+    worst = max(
+        np.hypot(*np.add(f[:2], record["support_forces"][n]))
+        for n, f in record["body_forces"].items()
+    )
+    return worst / max([q["normal_force"] for q in record["pairs"]] + [1e-300])
+
+
 def _stress_tensor(s):
     return ufl.as_matrix([[s[0], s[2]], [s[2], s[1]]])
 

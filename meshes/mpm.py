@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 import dolfinx_forms as df
+from dolfinx_forms.boundary import Dirichlet
 from dolfinx_forms.obstacles import RigidObstacle
 
 from .cut import CutBody, cut_scene, half_plane
@@ -142,3 +143,17 @@ def nine_discs(comm, R=1.7, plate=(1.0, 9.8), h=0.1, overlap=1e-3, margin=None):
         bodies.append((name, 10 + m, shape))
     build = grid_scene(comm, lines, lines, [(b[0], b[1]) for b in bodies], contact_box=False)
     return (lines, lines), bodies, build, {name: face for name, (_, face) in plates.items()}
+
+
+def plate_face_conditions(faces, displacement):
+    """Dirichlet conditions moving each plate's outer face (faces {name: (axis, coordinate)},
+    a grid line) inward by `displacement` per step, normal component only (the face's
+    tangential motion is free)."""
+    return [
+        Dirichlet(
+            lambda x, a=axis, c=c: np.isclose(x[a], c, rtol=0, atol=1e-9 * abs(c)),
+            axis,
+            -np.sign(c) * displacement,
+        )
+        for axis, c in faces.values()
+    ]
