@@ -53,13 +53,20 @@ def residual(q, law, u, gtp):
     return b
 
 
+@pytest.mark.parametrize("segmented", [False, True])
 @pytest.mark.parametrize("mu", [0.0, 0.4])
-def test_tangent_equals_finite_differences(mu):
+def test_tangent_equals_finite_differences(mu, segmented):
+    """Point-wise, and with the points grouped into segments of 1 to 4 points (one traction
+    per segment from its mean gaps): the tangent couples all dofs of a segment."""
     rng = np.random.default_rng(3)
-    q = make_quadrature(rng)
+    q = make_quadrature(rng, nq=120 if segmented else 40)
+    if segmented:
+        q.segments = np.sort(rng.integers(0, 40, len(q))).astype(np.int32)
     law = (1e-2, 2e-2, mu)
     u = rng.uniform(-0.02, 0.02, 2 * NNODES)
     gtp = rng.uniform(-0.01, 0.01, len(q)) if mu > 0 else np.zeros(0)
+    if segmented and mu > 0:  # one committed slip per segment, as the solver keeps it
+        gtp = gtp[np.searchsorted(q.segments, q.segments)]
     K, b, s = dense_tangent(q, law, u, gtp)
     states = np.bincount(s["state"], minlength=3)
     if mu > 0:
@@ -105,3 +112,42 @@ def test_mu_zero_touches_no_history():
     s = _cpp.assemble_contact(q, 1e-2, 1e-2, 0.0, u, np.zeros(0))
     assert s["gtp_trial"] is None
     assert np.all(s["tau_t"] == 0)
+
+
+def test_segment_traction_is_the_law_of_its_mean_gap():
+    """A segment's traction is Algorithm 1 on the weighted mean of its points' gaps (plus the
+    augmented Lagrangian's shift), the same on all its points; its residual is the sum of the
+    points' w B^T tau; single-point segments reproduce the point-wise kernel exactly."""
+    rng = np.random.default_rng(11)
+    q = make_quadrature(rng, nq=30)
+    u = rng.uniform(-0.02, 0.02, 2 * NNODES)
+    gtp = np.zeros(len(q))
+    eps_n, eps_t, mu = 1e-2, 2e-2, 0.3
+    point = _cpp.assemble_contact(q, eps_n, eps_t, mu, u, gtp)
+    b_point = residual(q, (eps_n, eps_t, mu), u, gtp)
+    q.segments = np.arange(len(q), dtype=np.int32)
+    single = _cpp.assemble_contact(q, eps_n, eps_t, mu, u, gtp)
+    np.testing.assert_array_equal(single["tau_n"], point["tau_n"])
+    np.testing.assert_array_equal(residual(q, (eps_n, eps_t, mu), u, gtp), b_point)
+
+    q.segments = np.repeat(np.arange(10), 3).astype(np.int32)
+    shift = np.repeat(rng.uniform(-0.01, 0, 10), 3)
+    s = _cpp.assemble_contact(q, eps_n, eps_t, mu, u, gtp, g_n_shift=shift)
+    w = q.weights
+    for k in range(10):
+        sl = slice(3 * k, 3 * k + 3)
+        gn = np.sum(w[sl] * point["g_n"][sl]) / w[sl].sum() + shift[3 * k]
+        gt = np.sum(w[sl] * point["g_t"][sl]) / w[sl].sum()
+        tn = min(gn, 0.0) / eps_n
+        np.testing.assert_allclose(s["tau_n"][sl], tn, rtol=1e-12, atol=1e-300)
+        if tn < 0:
+            tt = gt / eps_t
+            tt = tt if abs(tt) <= mu * abs(tn) else mu * abs(tn) * np.sign(tt)
+            np.testing.assert_allclose(s["tau_t"][sl], tt, rtol=1e-12)
+        np.testing.assert_array_equal(s["g_n"][sl], point["g_n"][sl])  # the points' own gaps
+    assert np.any(s["tau_n"] < 0) and np.any(s["tau_n"] == 0)
+    blocks = q.coupling_dofs()
+    assert len(blocks) == 10 and all(len(np.unique(b)) == len(b) for b in blocks)
+    with pytest.raises(ValueError, match="non-decreasing"):
+        q.segments = np.arange(len(q), dtype=np.int32)[::-1].copy()
+

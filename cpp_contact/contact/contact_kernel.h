@@ -32,12 +32,19 @@ struct ContactQuadrature {
   /// (nq, 2) displacement of side j at P_j not carried by dofs (a rigid obstacle's prescribed
   /// motion), added to u_j(P_j) in the jump of eq 26; empty: none
   std::vector<double> u_j_prescribed;
+  /// (nq,) non-decreasing segment index of each point; empty: every point is its own segment.
+  /// A segment carries one traction (one multiplier, a piecewise-constant pressure): the law
+  /// sees the weighted mean of its points' gaps, so the constraints are as many as the
+  /// segments, not as the points (no over-constraint of the P1/Q1 trace, stable pressure).
+  std::vector<std::int32_t> segments;
 
   /// @brief Number of quadrature points.
   std::size_t size() const { return weights.size(); }
   /// @brief Check that all arrays have consistent sizes.
   /// @throws std::invalid_argument naming the first inconsistent array
   void validate() const;
+  /// @brief Point ranges: segment s holds the points [offsets[s], offsets[s + 1]).
+  std::vector<std::size_t> segment_offsets() const;
 };
 
 /// @brief Traction state of every quadrature point after an evaluation.
@@ -59,6 +66,11 @@ enum class TangentMode { exact, finite_difference };
 
 /// @brief Contact residual and tangent of eq 48 for a body pair.
 ///
+/// Per segment S (a single point unless q.segments groups them), with weights w_p, W = sum w_p:
+/// the law (Algorithm 1) acts on the mean gaps gbar = sum w_p g_p / W (+ the mean shift), its
+/// tractions hold on every point of S, r += sum_p w_p B_p^T tau = [b_n b_t] tau with
+/// b = sum_p w_p B_p, and K += (1/W) [b_n b_t] D [b_n b_t]^T: the exact derivative. For a
+/// single point this is the point-wise form below.
 /// At each point: g_n = g_n0 + (u_j(P_j) - u_i(P_i)).n, g_t = (u_j - u_i).t (`point_gaps`,
 /// u_j(P_j) including q.u_j_prescribed;
 /// gaps.h, with u interpolated at P_i and P_j by the basis values), the return
@@ -78,15 +90,23 @@ enum class TangentMode { exact, finite_difference };
 /// add the tangent of a closed, sticking point (and no residual), slipping points the sticking
 /// tangent: for bodies held only by contacts that touch but are not yet closed, or that all
 /// slip in a first iterate far from equilibrium (0: off, the exact tangent)
-/// @return Per-point gaps, tractions, trial slip and states
+/// @param[in] g_n_shift (nq) added to the normal gap the law sees, or empty: the augmented
+/// Lagrangian's multiplier, eps_n lambda_n, so that tau_n = min(0, lambda_n + g_n / eps_n)
+/// (Uzawa, seed 003); the reported g_n stays the true gap
+/// @return Per-point gaps (the points' own), tractions, trial slip and states (their segment's)
 ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPenalty& law,
                                    std::span<const double> u, std::span<const double> gtp_old,
                                    std::span<double> b, const BlockInserter& insert,
                                    TangentMode mode = TangentMode::exact, double fd_step = 1e-8,
-                                   double closed_gap = 0.0);
+                                   double closed_gap = 0.0, std::span<const double> g_n_shift = {});
 
-/// @brief All block dofs of each point (nodes_i + nodes_j per point, point-major): the coupling
-/// blocks that the sparsity pattern must contain.
-std::vector<std::int32_t> coupling_dofs(const ContactQuadrature& q);
+/// @brief Coupling blocks of a pair, one per segment: the block dofs of all its points.
+struct CouplingBlocks {
+  std::vector<std::int32_t> dofs;   ///< block dofs, segment after segment (no repeats within)
+  std::vector<std::size_t> offsets; ///< segment s: dofs[offsets[s], offsets[s + 1])
+};
+
+/// @brief The coupling blocks that the sparsity pattern must contain.
+CouplingBlocks coupling_dofs(const ContactQuadrature& q);
 
 } // namespace contact

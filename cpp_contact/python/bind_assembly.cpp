@@ -58,6 +58,11 @@ void bind_assembly(py::module_& m) {
            py::arg("weights"), py::arg("normals"), py::arg("tangents"), py::arg("g_n0"),
            py::arg("dofs_i"), py::arg("dofs_j"), py::arg("basis_i"), py::arg("basis_j"))
       .def("__len__", &ContactQuadrature::size)
+      .def_property_readonly("weights",
+                             [](const ContactQuadrature& q) {
+                               return to_numpy(std::vector<double>(q.weights),
+                                               {py::ssize_t(q.size())});
+                             })
       .def_property_readonly("g_n0",
                              [](const ContactQuadrature& q) {
                                return to_numpy(std::vector<double>(q.g_n0),
@@ -77,38 +82,62 @@ void bind_assembly(py::module_& m) {
           },
           "(nq, 2) displacement of side j at P_j not carried by dofs (rigid obstacle motion), "
           "added to u_j(P_j) in the gaps; empty: none")
+      .def_property(
+          "segments",
+          [](const ContactQuadrature& q) {
+            return to_numpy(std::vector<std::int32_t>(q.segments),
+                            {py::ssize_t(q.segments.size())});
+          },
+          [](ContactQuadrature& q, const iarray& v) {
+            std::vector<std::int32_t> old = q.segments;
+            q.segments = copy_of(v);
+            try {
+              q.validate();
+            } catch (...) {
+              q.segments = old;
+              throw;
+            }
+          },
+          "(nq,) non-decreasing segment index of each point (one traction per segment); empty: "
+          "point-wise")
       .def(
           "coupling_dofs",
           [](const ContactQuadrature& q) {
-            return to_numpy(contact::coupling_dofs(q),
-                            {py::ssize_t(q.size()), py::ssize_t(q.nodes_i + q.nodes_j)});
+            const contact::CouplingBlocks c = contact::coupling_dofs(q);
+            py::list out;
+            for (std::size_t s = 0; s + 1 < c.offsets.size(); ++s)
+              out.append(to_numpy(std::vector<std::int32_t>(c.dofs.begin() + c.offsets[s],
+                                                            c.dofs.begin() + c.offsets[s + 1]),
+                                  {py::ssize_t(c.offsets[s + 1] - c.offsets[s])}));
+            return out;
           },
-          "Block dofs (nq, nodes_i + nodes_j) coupled by each point");
+          "Block dofs coupled by each segment (a list, one array per segment)");
 
   m.def(
       "insert_coupling",
       [](dolfinx::la::SparsityPattern& pattern, const ContactQuadrature& q) {
-        const std::vector<std::int32_t> dofs = contact::coupling_dofs(q);
-        const std::size_t nd = q.nodes_i + q.nodes_j;
-        for (std::size_t p = 0; p < q.size(); ++p) {
-          std::span<const std::int32_t> d(dofs.data() + p * nd, nd);
+        const contact::CouplingBlocks c = contact::coupling_dofs(q);
+        for (std::size_t s = 0; s + 1 < c.offsets.size(); ++s) {
+          std::span<const std::int32_t> d(c.dofs.data() + c.offsets[s],
+                                          c.offsets[s + 1] - c.offsets[s]);
           pattern.insert(d, d);
         }
       },
       py::arg("pattern"), py::arg("quadrature"),
-      "Add the contact coupling blocks of every point to a (not yet assembled) SparsityPattern");
+      "Add the contact coupling blocks of every segment to a (not yet assembled) SparsityPattern");
 
   m.def(
       "add_coupling_zeros",
       [](Mat A, const ContactQuadrature& q) {
         // PETSc squeezes preallocated but unused entries out at the first final assembly:
         // explicit zeros keep the contact blocks in the matrix for every later iteration.
-        const std::vector<std::int32_t> dofs = contact::coupling_dofs(q);
-        const std::size_t nd = q.nodes_i + q.nodes_j;
-        const std::vector<double> zeros(4 * nd * nd, 0.0);
-        for (std::size_t p = 0; p < q.size(); ++p) {
-          petsc_check(MatSetValuesBlockedLocal(A, PetscInt(nd), dofs.data() + p * nd, PetscInt(nd),
-                                               dofs.data() + p * nd, zeros.data(), ADD_VALUES),
+        const contact::CouplingBlocks c = contact::coupling_dofs(q);
+        for (std::size_t s = 0; s + 1 < c.offsets.size(); ++s) {
+          const auto nd = PetscInt(c.offsets[s + 1] - c.offsets[s]);
+          const std::vector<double> zeros(std::size_t(4 * nd * nd), 0.0);
+          petsc_check(MatSetValuesBlockedLocal(A, nd, c.dofs.data() + c.offsets[s], nd,
+                                               c.dofs.data() + c.offsets[s], zeros.data(),
+                                               ADD_VALUES),
                       "MatSetValuesBlockedLocal (coupling block outside the sparsity pattern)");
         }
       },
@@ -119,7 +148,8 @@ void bind_assembly(py::module_& m) {
       "assemble_contact",
       [](const ContactQuadrature& q, double eps_n, double eps_t, double mu, const carray& u,
          const carray& gtp_old, std::optional<py::array_t<double, py::array::c_style>> b,
-         std::optional<Mat> A, bool finite_difference, double fd_step, double closed_gap) {
+         std::optional<Mat> A, bool finite_difference, double fd_step, double closed_gap,
+         std::optional<carray> g_n_shift) {
         std::span<double> bs;
         if (b) {
           if (b->size() != u.size())
@@ -140,7 +170,8 @@ void bind_assembly(py::module_& m) {
                                             : contact::TangentMode::exact;
         contact::ContactPointState s = contact::assemble_contact(
             q, contact::CoulombPenalty{eps_n, eps_t, mu}, as_span(u, "u"),
-            as_span(gtp_old, "gtp_old"), bs, insert, mode, fd_step, closed_gap);
+            as_span(gtp_old, "gtp_old"), bs, insert, mode, fd_step, closed_gap,
+            g_n_shift ? as_span(*g_n_shift, "g_n_shift") : std::span<const double>());
         const auto nq = py::ssize_t(q.size());
         std::vector<std::int8_t> st(s.state.size());
         for (std::size_t p = 0; p < st.size(); ++p)
@@ -160,7 +191,10 @@ void bind_assembly(py::module_& m) {
       py::arg("quadrature"), py::arg("eps_n"), py::arg("eps_t"), py::arg("mu"), py::arg("u"),
       py::arg("gtp_old"), py::arg("b") = py::none(), py::arg("A") = py::none(),
       py::arg("finite_difference") = false, py::arg("fd_step") = 1e-8, py::arg("closed_gap") = 0.0,
+      py::arg("g_n_shift") = py::none(),
       "Contact residual (added into the local array b) and tangent (added into the PETSc Mat A "
       "by local block indices; call A.assemble() after) of eq 48. Returns a dict of per-point "
-      "g_n, g_t, tau_n, tau_t, state (int8 ContactState) and gtp_trial (None when mu == 0).");
+      "g_n, g_t, tau_n, tau_t, state (int8 ContactState) and gtp_trial (None when mu == 0); "
+      "tractions, states and gtp_trial are their segment's. g_n_shift: eps_n lambda_n of the "
+      "augmented Lagrangian (added to the gap the law sees), or None.");
 }
