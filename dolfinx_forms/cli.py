@@ -218,8 +218,21 @@ def demo_parser(prog, doc, out, options=(), discretization=True, petsc=True, cel
     if cells is not None:
         add_cells(p, *cells)
     if petsc:
+        add_enforcement(p)
         add_petsc(p)
     return p
+
+
+def add_enforcement(parser):
+    """--enforcement: penalty (eqs 8, 12) or augmented Lagrangian (Uzawa, seed 003)."""
+    parser.add_argument(
+        "--enforcement",
+        choices=["penalty", "augmented"],
+        default="penalty",
+        help="contact enforcement: penalty (the answer depends on --eps0) or augmented "
+        "(augmented Lagrangian with one pressure per contact segment: --eps0 sets only the "
+        "speed)",
+    )
 
 
 def add_cells(parser, quads, quads_help, triangles_help):

@@ -15,7 +15,9 @@ the reference configuration; Newton only changes u in the gaps (eqs 27-30). For 
    (eq 28, `_cpp.compute_gaps` in the reference configuration);
 5. the mesh cells containing P_i and P_j (binned point location in C++; on a cut scene's
    structured grid, index arithmetic) and the basis values there (basix), packed into a
-   `ContactQuadrature` for the C++ kernel (eq 48).
+   `ContactQuadrature` for the C++ kernel (eq 48);
+6. optionally (`segment_length`), the points grouped into segments of about that length
+   (`contact_segments`): one traction per segment, a pressure space the trace can carry.
 """
 
 from dataclasses import dataclass
@@ -43,6 +45,32 @@ class PairGeometry:
     grid_spacing: float
     search_box: np.ndarray  # (2, 2)
     obstacle: object = None  # obstacles.RigidObstacle on side j (no dofs), or None
+    segments: np.ndarray = None  # (nq,) segment of each point (sorted), or None: point-wise
+
+
+def contact_segments(points, weights, length, origin):
+    """Group contact points into segments of about `length`: the cells of a square lattice of
+    spacing `length` through `origin` that hold points; a cell holding less than 0.3 length of
+    Gamma_c (the curve cuts its corner) joins the nearest cell that holds more (by centroid),
+    so no segment constrains a sliver. Returns (order, segments): the permutation that sorts
+    the points by segment and the segment index 0..m-1 of each sorted point."""
+    cells = np.floor((np.asarray(points) - origin) / length).astype(np.int64)
+    _, label = np.unique(cells, axis=0, return_inverse=True)
+    label = label.ravel()
+    W = np.bincount(label, weights=weights)
+    centre = np.stack(
+        [np.bincount(label, weights=weights * points[:, c]) / W for c in range(2)], axis=1
+    )
+    big = np.flatnonzero(W >= 0.3 * length)
+    if len(big) == 0:
+        label[:] = 0
+    else:
+        d = np.linalg.norm(centre[:, None, :] - centre[None, big, :], axis=2)
+        target = np.where(W >= 0.3 * length, np.arange(len(W)), big[np.argmin(d, axis=1)])
+        label = target[label]
+    _, label = np.unique(label, return_inverse=True)
+    order = np.argsort(label, kind="stable")
+    return order, label[order].astype(np.int32)
 
 
 def _bbox(body):
@@ -208,6 +236,7 @@ def pair_geometry(
     projection="auto",
     obstacle=None,
     lattice_origin=None,
+    segment_length=0.0,
 ):
     """Contact quadrature of `pair` (indices into scene.bodies), or of body pair[0] and the
     rigid `obstacle` (pair[1] ignored): side j then has no dofs (nodes_j = 0).
@@ -218,6 +247,8 @@ def pair_geometry(
     grid_refine: level-set grid cells per mesh size h_contact.
     projection: "auto" (exact closest points on a body's analytic shape, eq 25 on the grid
     level set for a body without one) or "levelset" (eq 25 on the grid level sets for both).
+    segment_length: > 0 groups the points into segments of about that length, each with one
+    traction (`contact_segments`, on the pair-grid lattice); 0: one traction per point.
     Returns None when the pair cannot touch (disjoint inflated boxes or empty Gamma_c).
     """
     if projection not in ("auto", "levelset"):
@@ -268,6 +299,13 @@ def pair_geometry(
     }
     if len(s["weights"]) == 0:
         return None
+    segments = None
+    if segment_length > 0:
+        order, segments = contact_segments(s["points"], s["weights"], segment_length, box[0])
+        s = {
+            k: (v[order] if isinstance(v, np.ndarray) and len(v) == len(order) else v)
+            for k, v in s.items()
+        }
     proj = [
         closest_points(b, phi, s["points"], h, exact=projection == "auto")
         for b, phi in ((bi, phi_i), (bj, phi_j))
@@ -308,6 +346,20 @@ def pair_geometry(
     q = _cpp.ContactQuadrature(
         s["weights"], normals, tangents, g_n0, sides[0][0], sides[1][0], sides[0][1], sides[1][1]
     )
+    if segments is not None:
+        q.segments = segments
     return PairGeometry(
-        pair, s["points"], s["weights"], normals, tangents, p_i, p_j, g_n0, q, dx, box, obstacle
+        pair,
+        s["points"],
+        s["weights"],
+        normals,
+        tangents,
+        p_i,
+        p_j,
+        g_n0,
+        q,
+        dx,
+        box,
+        obstacle,
+        segments,
     )

@@ -6,6 +6,15 @@ the return mapping (Algorithm 1) and the residual and consistent tangent. The pl
 g_t^p (eqs 10-12) lives in one `_cpp.FrictionHistory` per pair: the kernel reads its
 committed values, each Newton iteration sets its trial values, an accepted step commits
 them and a rejected one restores them exactly.
+
+Enforcement: "penalty" (eqs 8, 12: the answer depends on eps) or "augmented" (augmented
+Lagrangian, Uzawa's outer loop of seed 003): per point multipliers lambda_n, lambda_t enter
+the law as tau_n = min(0, lambda_n + g_n / eps_n) (the kernel's gap shift eps_n lambda_n) and
+tau_t,trial = lambda_t + (g_t - g_t,start) / eps_t (through the slip the kernel reads); after
+each converged Newton solve `augment` sets lambda <- tau, until the tractions stop changing.
+The fixed point has zero mean gap on every active segment and zero slip over the step on every
+sticking one, whatever eps: eps sets the speed of the loop, not the answer. The multipliers of
+a step start from the committed tractions; a rejected step restores them.
 """
 
 import numpy as np
@@ -43,7 +52,12 @@ class ContactSet:
         rank=0,
         obstacles=(),
         lattice_origin=None,
+        segment_length=0.0,
+        enforcement="penalty",
     ):
+        if enforcement not in ("penalty", "augmented"):
+            raise ValueError(f"enforcement must be 'penalty' or 'augmented', got {enforcement!r}")
+        self.enforcement = enforcement
         self.eps_n, self.eps_t, self.mu = float(eps_n), float(eps_t), float(mu)
         self.pairs = []
         self.obstacles = list(obstacles)
@@ -53,7 +67,12 @@ class ContactSet:
             return rank.get(key, 0) if isinstance(rank, dict) else rank
 
         me = V.mesh.comm.rank
-        kw = dict(grid_refine=grid_refine, num_gauss=num_gauss, lattice_origin=lattice_origin)
+        kw = dict(
+            grid_refine=grid_refine,
+            num_gauss=num_gauss,
+            lattice_origin=lattice_origin,
+            segment_length=segment_length,
+        )
         candidates = [(tuple(pair), None) for pair in scene.pairs] + [
             ((i, -1), ob)
             for ob in self.obstacles
@@ -71,6 +90,10 @@ class ContactSet:
         self.slip_start = [np.zeros(len(g.weights)) for g in self.pairs]
         self.last = [None] * len(self.pairs)  # kernel output of the last evaluation
         self.committed = [None] * len(self.pairs)  # point states of the last accepted step
+        # augmented Lagrangian multipliers (per point, constant on a segment): the step's
+        # current ones and the committed tractions they start from
+        self.lambda_n = [np.zeros(len(g.weights)) for g in self.pairs]
+        self.lambda_t = [np.zeros(len(g.weights)) for g in self.pairs]
 
     def __len__(self):
         return len(self.pairs)
@@ -125,9 +148,27 @@ class ContactSet:
             out[g.obstacle.name] = (F0 + F, M0 + M)
         return out
 
+    @property
+    def augmented(self):
+        return self.enforcement == "augmented"
+
+    def _committed_tractions(self, k):
+        c = self.committed[k]
+        zero = np.zeros(len(self.pairs[k].weights))
+        return (zero, zero) if c is None else (c["tau_n"], c["tau_t"])
+
+    def _slip_read(self, k):
+        """The slip the kernel reads: the committed one, shifted in the augmented loop so that
+        tau_t,trial = lambda_t + (g_t - g_t,start) / eps_t (g_t,start = gtp_c + eps_t tau_c)."""
+        gtp = np.asarray(self.history[k].committed)
+        if not self.augmented:
+            return gtp
+        return gtp + self.eps_t * (self._committed_tractions(k)[1] - self.lambda_t[k])
+
     def _evaluate(self, k, u, b=None, A=None, fd=False, fd_step=1e-9, mu=None, closed_gap=0.0):
         mu = self.mu if mu is None else mu
-        gtp = self.history[k].committed if mu > 0 else _NONE
+        gtp = self._slip_read(k) if mu > 0 else _NONE
+        shift = self.eps_n * self.lambda_n[k] if self.augmented else None
         return _cpp.assemble_contact(
             self.pairs[k].quadrature,
             self.eps_n,
@@ -140,7 +181,49 @@ class ContactSet:
             fd,
             fd_step,
             closed_gap,
+            shift,
         )
+
+    def start_step(self):
+        """Multipliers of a new step (or a retried one): the committed tractions."""
+        for k in range(len(self.pairs)):
+            tn, tt = self._committed_tractions(k)
+            self.lambda_n[k], self.lambda_t[k] = tn.copy(), tt.copy()
+
+    def multipliers(self):
+        """The multipliers of all pairs on this rank as one vector [lambda_n..., lambda_t...]
+        (lambda_t only with friction)."""
+        parts = self.lambda_n + (self.lambda_t if self.mu > 0 else [])
+        return np.concatenate(parts) if parts else np.zeros(0)
+
+    def set_multipliers(self, x):
+        n = [len(g.weights) for g in self.pairs]
+        cuts = np.cumsum(n)[:-1] if n else []
+        self.lambda_n = [a.copy() for a in np.split(x[: sum(n)], cuts)]
+        if self.mu > 0:
+            self.lambda_t = [a.copy() for a in np.split(x[sum(n) :], cuts)]
+
+    def tractions(self):
+        """The tractions of the last evaluation, laid out as `multipliers` (Uzawa's T)."""
+        parts = [s["tau_n"] for s in self.last] + (
+            [s["tau_t"] for s in self.last] if self.mu > 0 else []
+        )
+        return np.concatenate(parts) if parts else np.zeros(0)
+
+    def mean_gaps(self):
+        """Largest |mean gap| of an active segment over the last evaluation (the constraint
+        the augmented loop enforces), 0 without active segments."""
+        worst = 0.0
+        for g, s in zip(self.pairs, self.last):
+            if s is None or len(s["g_n"]) == 0:
+                continue
+            seg = g.segments if g.segments is not None else np.arange(len(g.weights))
+            W = np.bincount(seg, weights=g.weights)
+            gbar = np.bincount(seg, weights=g.weights * s["g_n"]) / W
+            active = np.bincount(seg, weights=(s["state"] > 0).astype(float)) > 0
+            if active.any():
+                worst = max(worst, np.abs(gbar[active]).max())
+        return worst
 
     def assemble(self, u, b, A=None, fd=False, fd_step=1e-9, closed_gap=0.0):
         """Add the contact residual of displacement array u to the array b (local, with
@@ -166,12 +249,20 @@ class ContactSet:
 
     def set_friction(self, mu, u):
         """Change mu between stages. Switching friction on starts from zero tangential
-        traction: the committed plastic slip is the current tangential gap."""
+        traction: the committed plastic slip is the current (segment mean) tangential gap."""
         mu = float(mu)
         if mu > 0 and self.mu == 0:
             for k, h in enumerate(self.history):
-                h.trial = self._evaluate(k, u, mu=0.0)["g_t"]
+                g = self.pairs[k]
+                gt = self._evaluate(k, u, mu=0.0)["g_t"]
+                if g.segments is not None:
+                    W = np.bincount(g.segments, weights=g.weights)
+                    gt = (np.bincount(g.segments, weights=g.weights * gt) / W)[g.segments]
+                h.trial = gt
                 h.commit()
+                self.lambda_t[k] = np.zeros(len(g.weights))
+                if self.committed[k] is not None:
+                    self.committed[k]["tau_t"] = np.zeros(len(g.weights))
                 self.slip_start[k] = h.committed
         self.mu = mu
 

@@ -45,6 +45,7 @@ PROBLEM_OPTIONS = {
     "ghost_penalty": "ghost_penalty",
     "grid_refine": "grid_refine",
     "petsc": "petsc_options",
+    "enforcement": "enforcement",
 }
 
 

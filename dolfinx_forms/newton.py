@@ -28,6 +28,10 @@ class NewtonOptions:
     max_cutbacks: int = 6
     fd_tangent: bool = False  # verification only: central differences of the contact residual
     fd_step: float = 1e-9
+    # augmented Lagrangian (Uzawa): stop when no multiplier changes by more than al_rtol of
+    # the largest traction; a step that needs more than max_augmentations solves fails
+    al_rtol: float = 1e-9
+    max_augmentations: int = 200
 
 
 @dataclass
@@ -36,17 +40,24 @@ class StepLog:
     iterations: int
     residuals: list = field(default_factory=list)
     cutback: bool = False
+    augmentations: int = 0  # Uzawa updates of the multipliers (augmented Lagrangian)
 
 
-def newton(problem, lam):
+def newton(problem, lam, r_ref=0.0):
     """Newton at load level lam from the committed state of `problem` (a ContactProblem).
+    r_ref: a residual that the relative test may also refer to (the step's first residual, for
+    the later solves of an augmented Lagrangian loop, which start near the answer).
     Returns (ok, residuals, why)."""
     opts = problem.newton
     problem.set_bc_values(lam)
     residuals, seen = [], {}
     r0 = None
+    # the later solves of an augmented loop start from a converged state (no predictor) and
+    # take at least one iteration: the multipliers' change is below the step's tolerance
+    later = r_ref > 0
     for it in range(opts.max_iterations + 1):
-        r = problem.residual(lam, with_tangent=True, predictor=it == 0)
+        predictor = it == 0 and not later and problem.predictor_gap > 0
+        r = problem.residual(lam, with_tangent=True, predictor=predictor)
         residuals.append(r)
         if not np.isfinite(r):
             return (
@@ -59,11 +70,13 @@ def newton(problem, lam):
                 ),
             )
         if r0 is None:
-            r0 = r
+            r0 = max(r, r_ref)
         # relative to the step's first residual, with a round-off floor relative to the
         # problem's force scale: no absolute floor that would accept the initial guess of a
         # problem with small forces (E = 1e-12 converges like E = 1)
-        if r <= max(opts.rtol * r0, opts.ftol * problem.force_scale, opts.atol):
+        if (it > 0 or not later) and r <= max(
+            opts.rtol * r0, opts.ftol * problem.force_scale, opts.atol
+        ):
             return True, residuals, ""
         if it > 0:
             dnorm, unorm = problem.du.vector.norm(), problem.u.vector.norm()
@@ -84,9 +97,21 @@ def newton(problem, lam):
         seen[sig] = min(r, seen.get(sig, np.inf))
         if it == opts.max_iterations:
             break
+        # The factorisation is reused when J is the same matrix: a linear bulk, the same active
+        # set, mu and a constant contact tangent (frictionless or no slipping point), no predictor
+        key = None
+        if not problem.bulk.nonlinear and not predictor:
+            slip = problem.contact.mu > 0 and problem.comm.allreduce(
+                int(problem.contact.state_counts()[2]), MPI.SUM
+            )
+            key = None if slip else (sig, problem.contact.mu)
         with problem.phase("solve"):
             problem.R.scale(-1.0)
             try:
+                reuse = key is not None and key == problem.factor_key
+                problem.ksp.getPC().setReusePreconditioner(reuse)
+                problem.factor_key = key
+                problem.factorisations += not reuse
                 problem.ksp.setOperators(problem.J)
                 problem.ksp.solve(problem.R, problem.du.vector)
             except PETSc.Error as e:
@@ -103,6 +128,55 @@ def newton(problem, lam):
     return False, residuals, f"no convergence in {opts.max_iterations} iterations"
 
 
+def _dot(comm, a, b):
+    return comm.allreduce(float(np.dot(a, b)), MPI.SUM)
+
+
+def augmented_loop(problem, lam, residuals, depth=20):
+    """The augmented Lagrangian's outer loop at load level lam, after a converged Newton solve:
+    the fixed point lambda = T(lambda), T(lambda) = the tractions of the solution with
+    multipliers lambda (Uzawa's update, seed 003), accelerated by Anderson mixing of the last
+    `depth` iterates (Walker & Ni 2011; restarted when the update grows). Stops when no
+    multiplier changes by more than al_rtol of the largest traction. Appends the inner Newton
+    residuals to `residuals`. Returns (ok, augmentations, why)."""
+    cs, comm, opts = problem.contact, problem.comm, problem.newton
+    X, F = [], []
+    x = cs.multipliers()
+    for k in range(opts.max_augmentations + 1):
+        f = cs.tractions() - x
+        change = comm.allreduce(float(np.abs(f).max()) if f.size else 0.0, MPI.MAX)
+        scale = comm.allreduce(float(np.abs(cs.tractions()).max()) if f.size else 0.0, MPI.MAX)
+        if change <= opts.al_rtol * scale:
+            return True, k, ""
+        if k == opts.max_augmentations:
+            break
+        if F and _dot(comm, f, f) > 4.0 * _dot(comm, F[-1], F[-1]):
+            X, F = [], []  # the mixing made it worse: restart from a plain Uzawa step
+        X.append(x.copy())
+        F.append(f.copy())
+        X, F = X[-(depth + 1) :], F[-(depth + 1) :]
+        x_new = x + f
+        if len(F) > 1:
+            dF = np.array([F[i + 1] - F[i] for i in range(len(F) - 1)])
+            dX = np.array([X[i + 1] - X[i] for i in range(len(X) - 1)])
+            G = comm.allreduce(dF @ dF.T, MPI.SUM)
+            rhs = comm.allreduce(dF @ f, MPI.SUM)
+            gamma = np.linalg.lstsq(G + 1e-14 * np.trace(G) * np.eye(len(G)), rhs, rcond=None)[0]
+            x_new = x + f - (dX + dF).T @ gamma
+        x = x_new
+        cs.set_multipliers(x)
+        ok, more, why = newton(problem, lam, residuals[0])
+        residuals += more
+        if not ok:
+            return False, k + 1, why
+    return (
+        False,
+        opts.max_augmentations,
+        f"augmented Lagrangian: multipliers still change by {change / scale:.2e} of the "
+        f"largest traction after {opts.max_augmentations} updates",
+    )
+
+
 def load_steps(problem, num_steps=1, lam_end=1.0, label="step", initial_guess=None):
     """Ramp the load level of `problem` from its committed value to lam_end in num_steps
     equal steps, with cut-back; one progress line per accepted step. initial_guess(problem,
@@ -114,13 +188,22 @@ def load_steps(problem, num_steps=1, lam_end=1.0, label="step", initial_guess=No
         if initial_guess is not None:
             initial_guess(problem, target)
         t0 = time.perf_counter()
+        problem.contact.start_step()
         ok, residuals, why = newton(problem, target)
+        augmentations = 0
+        if ok and problem.contact.augmented:
+            ok, augmentations, why = augmented_loop(problem, target, residuals)
         if ok:
             problem.commit(target)
-            problem.steps.append(StepLog(target, len(residuals) - 1, residuals, cuts > 0))
+            problem.steps.append(
+                StepLog(target, len(residuals) - 1 - augmentations, residuals, cuts > 0)
+            )
+            problem.steps[-1].augmentations = augmentations
             nst = problem.comm.allreduce(problem.contact.state_counts(), MPI.SUM)
+            aug = f" in {augmentations + 1} augmented solves" if problem.contact.augmented else ""
             problem.log(
-                f"{label} lam={target:.4f}: {len(residuals) - 1} Newton iterations, "
+                f"{label} lam={target:.4f}: {len(residuals) - 1 - augmentations} Newton "
+                f"iterations{aug}, "
                 f"|R| {residuals[0]:.2e} -> {residuals[-1]:.2e}, "
                 f"open/stick/slip {nst[0]}/{nst[1]}/{nst[2]} "
                 f"({time.perf_counter() - t0:.2f} s)"

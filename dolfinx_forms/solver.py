@@ -46,6 +46,10 @@ class ContactProblem:
     not closed yet are held (a length; 0: exact tangent throughout; the answer is unchanged).
     pair_grid_origin: None, or a point through which every pair's level-set grid passes
     (`contact.pair_geometry`'s lattice_origin: symmetric scenes stay symmetric).
+    enforcement: "penalty" (the answer depends on eps0) or "augmented" (augmented Lagrangian,
+    Uzawa loop, `contact_set`: eps0 sets only the loop's speed). segment_length: contact
+    points grouped into segments of about that length, one traction each (a stable pressure at
+    any eps0); None: h_contact with "augmented", point-wise (0) with "penalty".
     """
 
     def __init__(
@@ -73,6 +77,8 @@ class ContactProblem:
         rigid_mode_stiffness=0.0,
         predictor_gap=0.0,
         pair_grid_origin=None,
+        enforcement="penalty",
+        segment_length=None,
         log=print,
     ):
         self.scene, self.mesh = scene, scene.mesh
@@ -137,6 +143,12 @@ class ContactProblem:
                 contact_rank,
                 obstacles,
                 pair_grid_origin,
+                segment_length=(
+                    (h if enforcement == "augmented" else 0.0)
+                    if segment_length is None
+                    else float(segment_length)
+                ),
+                enforcement=enforcement,
             )
         self.pairs = self.contact.pairs
 
@@ -175,6 +187,8 @@ class ContactProblem:
         for k, v in {**defaults, **(petsc_options or {})}.items():
             opts["ils_" + k] = v
         self.ksp.setFromOptions()
+        self.factor_key = None  # what the last factorisation was of (newton.py reuses it)
+        self.factorisations = 0
         self.u_committed = self.u.x.array.copy()
         self.lam = 0.0
         self.steps = []
@@ -281,7 +295,10 @@ def solver_metrics(problem, converged=True):
         "converged": bool(converged),
         "residual_history": [[float(r) for r in s.residuals] for s in problem.steps],
         "penalty": {"eps_n": problem.eps_n, "eps_t": problem.eps_t},
+        "enforcement": problem.contact.enforcement,
+        "augmentations": [int(s.augmentations) for s in problem.steps],
         "cutbacks": int(sum(s.cutback for s in problem.steps)),
+        "factorisations": int(problem.factorisations),
     }
 
 

@@ -150,4 +150,3 @@ def test_segment_traction_is_the_law_of_its_mean_gap():
     assert len(blocks) == 10 and all(len(np.unique(b)) == len(b) for b in blocks)
     with pytest.raises(ValueError, match="non-decreasing"):
         q.segments = np.arange(len(q), dtype=np.int32)[::-1].copy()
-
