@@ -45,7 +45,9 @@ def contact_results(pts, mu):
     res["contact_half_width"] = None if xl is None else float(0.5 * (xr - xl))
     res["contact_centre"] = None if xl is None else float(0.5 * (xr + xl))
     if mu > 0:
-        slipped = np.abs(slip) > 1e-9 * max(np.abs(slip).max(initial=0.0), 1e-300)
+        # 1e-6 of the largest slip: the penalty's stick points have none at all, the augmented
+        # Lagrangian's what its loop tolerance leaves (eps_t al_rtol tau)
+        slipped = np.abs(slip) > 1e-6 * max(np.abs(slip).max(initial=0.0), 1e-300)
         sl, sr = zone_ends(x, active & ~slipped)
         res["stick_half_width"] = None if sl is None else float(0.5 * (sr - sl))
     return res

@@ -203,6 +203,17 @@ class ContactSet:
         if self.mu > 0:
             self.lambda_t = [a.copy() for a in np.split(x[sum(n) :], cuts)]
 
+    def admissible(self, x):
+        """x (laid out as `multipliers`) projected on the admissible tractions: lambda_n <= 0,
+        |lambda_t| <= mu |lambda_n| (an extrapolated update may leave them)."""
+        n = sum(len(g.weights) for g in self.pairs)
+        x = x.copy()
+        x[:n] = np.minimum(x[:n], 0.0)
+        if self.mu > 0:
+            bound = self.mu * np.abs(x[:n])
+            x[n:] = np.clip(x[n:], -bound, bound)
+        return x
+
     def tractions(self):
         """The tractions of the last evaluation, laid out as `multipliers` (Uzawa's T)."""
         parts = [s["tau_n"] for s in self.last] + (
@@ -281,8 +292,12 @@ class ContactSet:
         out = []
         for k, g in enumerate(self.pairs):
             s = self.committed[k] if self.committed[k] is not None else self._evaluate(k, u)
-            # plastic slip accumulated since friction was switched on (mu = 0: all of g_t)
+            # plastic slip accumulated since friction was switched on (mu = 0: all of g_t);
+            # augmented: the whole tangential gap (g_t = g_t^p + eps_t tau_t) since then, as
+            # the converged stick is exact
             slip = self.history[k].committed - self.slip_start[k] if self.mu > 0 else s["g_t"]
+            if self.mu > 0 and self.augmented:
+                slip = slip + self.eps_t * s["tau_t"]
             out.append(
                 dict(
                     x=g.points[:, 0],

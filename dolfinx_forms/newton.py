@@ -30,6 +30,8 @@ class NewtonOptions:
     fd_step: float = 1e-9
     # augmented Lagrangian (Uzawa): stop when no multiplier changes by more than al_rtol of
     # the largest traction; a step that needs more than max_augmentations solves fails
+    line_search: bool = True  # halve a Newton step that does not lower the residual
+    max_backtracks: int = 5
     al_rtol: float = 1e-9
     max_augmentations: int = 200
 
@@ -55,6 +57,7 @@ def newton(problem, lam, r_ref=0.0):
     # the later solves of an augmented loop start from a converged state (no predictor) and
     # take at least one iteration: the multipliers' change is below the step's tolerance
     later = r_ref > 0
+    r_base, sig_base, backtracks = None, None, 0  # where the last Newton step started
     for it in range(opts.max_iterations + 1):
         predictor = it == 0 and not later and problem.predictor_gap > 0
         r = problem.residual(lam, with_tangent=True, predictor=predictor)
@@ -91,6 +94,14 @@ def newton(problem, lam, r_ref=0.0):
         # live on the ranks that hold the pairs: the set compared is the union over the ranks
         # (one rank's part can repeat while another's changes).
         sig = tuple(problem.comm.allgather(problem.contact.signature()))
+        # Line search: a step that keeps the active set but does not lower the residual (the
+        # slip law's curvature) is halved, u = u_base + alpha du. A step that changes the active
+        # set is taken whole: the semismooth Newton's residual need not fall monotonically.
+        if opts.line_search and r_base is not None and r > r_base and sig == sig_base:
+            if backtracks < opts.max_backtracks and it < opts.max_iterations:
+                backtracks += 1
+                problem.u.x.array[:] -= 0.5**backtracks * problem.du.x.array
+                continue
         cycling = any(sig) and sig in seen and r >= 0.999 * seen[sig]
         if cycling:
             return False, residuals, f"active set cycles (iteration {it})"
@@ -105,6 +116,7 @@ def newton(problem, lam, r_ref=0.0):
                 int(problem.contact.state_counts()[2]), MPI.SUM
             )
             key = None if slip else (sig, problem.contact.mu)
+        r_base, sig_base, backtracks = r, sig, 0
         with problem.phase("solve"):
             problem.R.scale(-1.0)
             try:
@@ -142,10 +154,14 @@ def augmented_loop(problem, lam, residuals, depth=20):
     cs, comm, opts = problem.contact, problem.comm, problem.newton
     X, F = [], []
     x = cs.multipliers()
+    u_good = problem.u.x.array.copy()  # the last converged solve and its tractions
+    t_good = cs.tractions()
+    fallbacks = 0
     for k in range(opts.max_augmentations + 1):
-        f = cs.tractions() - x
+        t = cs.tractions()
+        f = t - x
         change = comm.allreduce(float(np.abs(f).max()) if f.size else 0.0, MPI.MAX)
-        scale = comm.allreduce(float(np.abs(cs.tractions()).max()) if f.size else 0.0, MPI.MAX)
+        scale = comm.allreduce(float(np.abs(t).max()) if f.size else 0.0, MPI.MAX)
         if change <= opts.al_rtol * scale:
             return True, k, ""
         if k == opts.max_augmentations:
@@ -155,20 +171,33 @@ def augmented_loop(problem, lam, residuals, depth=20):
         X.append(x.copy())
         F.append(f.copy())
         X, F = X[-(depth + 1) :], F[-(depth + 1) :]
-        x_new = x + f
+        x = x + f  # Uzawa: lambda <- tau
         if len(F) > 1:
             dF = np.array([F[i + 1] - F[i] for i in range(len(F) - 1)])
             dX = np.array([X[i + 1] - X[i] for i in range(len(X) - 1)])
             G = comm.allreduce(dF @ dF.T, MPI.SUM)
             rhs = comm.allreduce(dF @ f, MPI.SUM)
             gamma = np.linalg.lstsq(G + 1e-14 * np.trace(G) * np.eye(len(G)), rhs, rcond=None)[0]
-            x_new = x + f - (dX + dF).T @ gamma
-        x = x_new
+            x = cs.admissible(x - (dX + dF).T @ gamma)
+        cs.set_multipliers(x)
+        ok, more, why = newton(problem, lam, residuals[0])
+        residuals += more
+        if ok:
+            u_good[:], t_good = problem.u.x.array, cs.tractions()
+            continue
+        if len(F) <= 1 or fallbacks == 3:
+            return False, k + 1, f"augmented Lagrangian, update {k + 1}: {why}"
+        # a mixed update too far for Newton: back to the last solve, a plain Uzawa step
+        fallbacks += 1
+        X, F = [], []
+        problem.u.x.array[:] = u_good
+        x = t_good.copy()
         cs.set_multipliers(x)
         ok, more, why = newton(problem, lam, residuals[0])
         residuals += more
         if not ok:
-            return False, k + 1, why
+            return False, k + 1, f"augmented Lagrangian, update {k + 1}: {why}"
+        u_good[:], t_good = problem.u.x.array, cs.tractions()
     return (
         False,
         opts.max_augmentations,
