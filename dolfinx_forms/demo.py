@@ -243,6 +243,8 @@ def run_case(
         return 1
     folder = write(run, out, force, plot=plot, files=files)
     if run.rank0:
+        for w in run.metrics.get("solver", {}).get("warnings", []):
+            print(f"WARNING: {w}")
         if summary is not None:
             print(summary(run) if callable(summary) else summary.format(**run.metrics))
         print(f"results in {folder}")

@@ -181,6 +181,7 @@ def run_steps(
     rank 0. Returns the exit status."""
     from mpi4py import MPI
 
+    from .checks import contact_warnings
     from .folders import atomic_output_dir
     from .results import write_metrics
 
@@ -190,12 +191,15 @@ def run_steps(
     run = StepRun(name, comm, metrics, PhaseTimer(metrics))
     points_series, grid_series = {}, Series("levelsets")
     run.data["series"] = points_series  # {body name: Series} of the material points (rank 0)
+    checks = {}  # warning -> first step where it was seen
     try:
         run.sim = build(run)
         x0 = None
         for k in range(num_steps):
             rec = run.sim.step()
             run.records.append(rec)
+            for w in contact_warnings(run.sim.problem):
+                checks.setdefault(w, rec["step"])
             run.rows.append(row(run, rec))
             if x0 is None:  # positions at seeding: the first step's points before it moved
                 x0 = {
@@ -218,7 +222,7 @@ def run_steps(
         residual_history=[],
         penalty={"eps_n": run.sim.problem.eps_n, "eps_t": run.sim.problem.eps_t},
         cutbacks=int(sum(r["cutbacks"] for r in run.records)),
-        warnings=[],
+        warnings=[f"step {k}: {w}" for w, k in checks.items()],
     )
     if evaluate is not None and comm.rank == 0:
         evaluate(run)

@@ -128,6 +128,7 @@ class ContactProblem:
             self.bc_global = (self.bc_owned + imap.local_range[0] * self.bs).astype(np.int32)
 
         h = scene.h_contact
+        self.band = band if band is not None else 2 * h
         E_mean = np.mean([law.modulus for law in self.laws.values()])
         self.eps_n = self.eps_t = eps0 * h / E_mean  # eq 51
         with self.phase("contact"):
@@ -137,7 +138,7 @@ class ContactProblem:
                 self.eps_n,
                 self.eps_t,
                 mu,
-                band if band is not None else 2 * h,
+                self.band,
                 grid_refine,
                 num_gauss,
                 contact_rank,
@@ -288,8 +289,12 @@ class ContactProblem:
 
 
 def solver_metrics(problem, converged=True):
-    """The `solver` block of metrics.json."""
+    """The `solver` block of metrics.json, with the failed checks of the final state
+    (`checks.contact_warnings`) in `warnings`."""
+    from .checks import contact_warnings
+
     return {
+        "warnings": contact_warnings(problem),
         "load_steps": len(problem.steps),
         "newton_iterations": [s.iterations for s in problem.steps],
         "converged": bool(converged),

@@ -37,7 +37,9 @@ def run(demo, out, *args):
 
 
 def points(out):
-    d = np.genfromtxt(Path(out) / "tractions.csv", delimiter=",", names=True, dtype=None, encoding="utf-8")
+    d = np.genfromtxt(
+        Path(out) / "tractions.csv", delimiter=",", names=True, dtype=None, encoding="utf-8"
+    )
     return d[np.argsort(d["x"])]
 
 

@@ -1,0 +1,66 @@
+"""The self-checks of a converged contact state (checks.py): each one fires on the case it is
+for and stays quiet on a sound one; a demo run outside the penalty's window reports them in
+metrics.json and on the console (exit 0, the answer flagged, not silently wrong)."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+
+from dolfinx_forms.checks import PENETRATION, pair_warnings
+
+ROOT = Path(__file__).resolve().parents[1]
+H, BAND = 0.1, 0.2
+
+
+def pair(state, g_n=None, g_n0=None):
+    n = len(state)
+    x = np.linspace(0, 1, n)
+    g = SimpleNamespace(
+        points=np.c_[x, np.zeros(n)][::-1].copy(),  # any order: sorted along the tangent
+        tangents=np.tile([1.0, 0.0], (n, 1)),
+        g_n0=np.zeros(n) if g_n0 is None else g_n0[::-1].copy(),
+    )
+    s = dict(
+        state=np.asarray(state, np.int8)[::-1].copy(),
+        g_n=(np.full(n, -1e-4 * H) if g_n is None else g_n)[::-1].copy(),
+    )
+    return g, s
+
+
+def test_sound_state_is_quiet():
+    assert pair_warnings(*pair([0, 0, 2, 2, 2, 2, 0]), H, BAND, "a-b") == []
+    # two separate contact spots of one pair: one gap, not a checkerboard
+    assert pair_warnings(*pair([0, 2, 2, 0, 0, 2, 2, 0]), H, BAND, "a-b") == []
+    assert pair_warnings(*pair([0, 2, 0, 2, 2, 0]), H, BAND, "a-b") == []
+
+
+def test_checkerboard():
+    (w,) = pair_warnings(*pair([0, 2, 0, 2, 0, 2, 0, 2, 0]), H, BAND, "a-b")
+    assert w.startswith("a-b: 3 open points between two active ones")
+
+
+def test_penetration_and_band():
+    g_n = np.full(5, -1.5 * PENETRATION * H)
+    g_n0 = np.array([0.0, 0.0, 0.0, 0.0, 0.95 * BAND])
+    w = pair_warnings(*pair([2, 2, 2, 2, 2], g_n, g_n0), H, BAND, "a-b")
+    assert len(w) == 2 and "penetration" in w[0] and "within 10 % of the band" in w[1]
+
+
+def test_demo_reports_soft_penalty(tmp_path):
+    out = tmp_path / "soft"
+    r = subprocess.run(
+        [sys.executable, str(ROOT / "demos" / "hertz.py"), "--h", "0.1", "--eps0", "100"]
+        + ["--out", str(out)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
+    assert r.returncode == 0, r.stderr
+    warnings = json.loads((out / "metrics.json").read_text())["solver"]["warnings"]
+    assert any("penetration" in w for w in warnings)
+    assert any("band" in w for w in warnings)
+    assert sum(line.startswith("WARNING: ") for line in r.stdout.splitlines()) == len(warnings)
