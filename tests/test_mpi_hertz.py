@@ -4,7 +4,8 @@ body-fitted and cut (cut cells, ghost-penalty facets across the partition bounda
 The scene partitioner puts every cell of the contact search box on rank 0, so the contact
 points and both bodies' cells around them are local there; the other rank only assembles
 bulk elasticity. The reaction of the distributed problem must equal the serial one (each rank
-also solves the same problem on COMM_SELF) to 1e-8 relative.
+also solves the same problem on COMM_SELF) to 1e-8 relative, with the penalty and with the
+augmented Lagrangian (its loop's tests and Anderson's inner products reduced over the ranks).
 """
 
 import numpy as np
@@ -16,7 +17,7 @@ from meshes.cut import hertz_cut_scene
 from meshes.hertz import hertz_scene
 
 
-def reaction(comm, mu, disc="conforming"):
+def reaction(comm, mu, disc="conforming", enforcement="penalty"):
     make = hertz_cut_scene if disc == "cut" else hertz_scene
     scene = make(comm, R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.6)
     mat = {b.tag: (1e4, 0.3) for b in scene.bodies}
@@ -29,6 +30,7 @@ def reaction(comm, mu, disc="conforming"):
         eps0=0.5,
         band=0.13,
         dirichlet=[Dirichlet("block_bottom", None, 0.0), top_x, top_y],
+        enforcement=enforcement,
         log=lambda *a: None,
     )
     p.solve(2)
@@ -43,13 +45,21 @@ def reaction(comm, mu, disc="conforming"):
 
 @pytest.mark.mpi
 @pytest.mark.parametrize(
-    "mu,disc", [(0.0, "conforming"), (0.3, "conforming"), (0.0, "cut"), (0.3, "cut")]
+    "mu,disc,enforcement",
+    [
+        (0.0, "conforming", "penalty"),
+        (0.3, "conforming", "penalty"),
+        (0.0, "cut", "penalty"),
+        (0.3, "cut", "penalty"),
+        (0.3, "conforming", "augmented"),
+        (0.0, "cut", "augmented"),
+    ],
 )
-def test_two_ranks_match_one(mu, disc):
+def test_two_ranks_match_one(mu, disc, enforcement):
     world = MPI.COMM_WORLD
     assert world.size == 2, "run under mpirun -n 2"
-    r2, n2 = reaction(world, mu, disc)
-    r1, n1 = reaction(MPI.COMM_SELF, mu, disc)
+    r2, n2 = reaction(world, mu, disc, enforcement)
+    r1, n1 = reaction(MPI.COMM_SELF, mu, disc, enforcement)
     assert n1 == n2
     assert abs(r2[1]) > 100
     np.testing.assert_allclose(r2, r1, rtol=1e-8, atol=1e-8 * abs(r1[1]))
