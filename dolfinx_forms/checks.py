@@ -7,10 +7,10 @@ them) and returns, on every rank, one line per failed check:
   load: its answer then depends on eps0);
 * band: an active point whose initial gap is within 10 % of the contact band (Gamma_c covers
   initial gaps up to the band only: the zone may be cut at its edge, give a larger band);
-* checkerboard: open points whose two neighbours along a pair's contact surface are active,
-  twice or more (more point-wise constraints than the trace can follow: a stiff point-wise
-  penalty; the augmented enforcement's segments do not do this). Two separate contact spots
-  of one pair (rough grains) are not flagged: one gap between them.
+* checkerboard: two or more runs of open points between active ones along a pair's contact
+  surface, each shorter than h (more point-wise constraints than the trace can follow: a
+  stiff point-wise penalty; the augmented enforcement's segments do not do this). Separate
+  contact spots of one pair (rough grains) are further apart than h, or are one gap.
 
 The demos put them in metrics.json (`solver.warnings`) and on the console.
 """
@@ -41,14 +41,25 @@ def pair_warnings(g, s, h, band, name):
     # order along the pair's mean tangent (a contact surface per pair is a curve)
     t = np.mean(g.tangents, axis=0)
     t = t / max(np.linalg.norm(t), 1e-300)
-    a = active[np.argsort(g.points @ t, kind="stable")]
-    holes = int(np.sum(~a[1:-1] & a[:-2] & a[2:]))
+    holes = short_gaps(g.points @ t, active, h)
     if holes >= 2:
         out.append(
-            f"{name}: {holes} open points between two active ones (a pressure checkerboard: "
+            f"{name}: {holes} gaps shorter than h in the contact zone (a pressure checkerboard: "
             "point-wise penalty too stiff for the mesh; raise eps0, or --enforcement augmented)"
         )
     return out
+
+
+def short_gaps(u, active, h):
+    """Runs of inactive points between active ones, along the coordinate u, whose active
+    neighbours are less than h apart."""
+    order = np.argsort(u, kind="stable")
+    u, a = u[order], active[order]
+    idx = np.flatnonzero(a)
+    if len(idx) < 2:
+        return 0
+    jumps = np.flatnonzero(np.diff(idx) > 1)  # idx[k] active, idx[k + 1] the next active
+    return int(np.sum(u[idx[jumps + 1]] - u[idx[jumps]] < h))
 
 
 def contact_warnings(problem):
