@@ -45,7 +45,8 @@ def pair_warnings(g, s, h, band, name):
     if holes >= 2:
         out.append(
             f"{name}: {holes} gaps shorter than h in the contact zone (a pressure checkerboard: "
-            "point-wise penalty too stiff for the mesh; raise eps0, or --enforcement augmented)"
+            "more constraints than the mesh can follow; penalty: raise eps0 or use --enforcement "
+            "augmented; augmented: a larger multiplier spacing)"
         )
     return out
 

@@ -16,8 +16,9 @@ the reference configuration; Newton only changes u in the gaps (eqs 27-30). For 
 5. the mesh cells containing P_i and P_j (binned point location in C++; on a cut scene's
    structured grid, index arithmetic) and the basis values there (basix), packed into a
    `ContactQuadrature` for the C++ kernel (eq 48);
-6. optionally (`segment_length`), the points grouped into segments of about that length
-   (`contact_segments`): one traction per segment, a pressure space the trace can carry.
+6. optionally (`multipliers`), the multiplier nodes along Gamma_c (`multiplier_nodes`): one
+   traction per node, piecewise constant (P0) or linear (P1) along the contact surface's
+   curves, about h apart: a pressure space the trace can carry.
 """
 
 from dataclasses import dataclass
@@ -45,32 +46,105 @@ class PairGeometry:
     grid_spacing: float
     search_box: np.ndarray  # (2, 2)
     obstacle: object = None  # obstacles.RigidObstacle on side j (no dofs), or None
-    segments: np.ndarray = None  # (nq,) segment of each point (sorted), or None: point-wise
+    # (nq, 2) multiplier nodes of each point and their weights (`multiplier_nodes`), or None:
+    # every point carries its own traction
+    mult_nodes: np.ndarray = None
+    mult_weights: np.ndarray = None
+
+    @property
+    def num_law_points(self):
+        return len(self.weights) if self.mult_nodes is None else int(self.mult_nodes.max()) + 1
+
+    def to_points(self, law_values):
+        """Values at the law points (multiplier nodes) interpolated to the points."""
+        if self.mult_nodes is None:
+            return law_values
+        v = np.asarray(law_values)[np.maximum(self.mult_nodes, 0)]
+        return np.sum(np.where(self.mult_nodes >= 0, self.mult_weights * v, 0.0), axis=1)
 
 
-def contact_segments(points, weights, length, origin):
-    """Group contact points into segments of about `length`: the cells of a square lattice of
-    spacing `length` through `origin` that hold points; a cell holding less than 0.3 length of
-    Gamma_c (the curve cuts its corner) joins the nearest cell that holds more (by centroid),
-    so no segment constrains a sliver. Returns (order, segments): the permutation that sorts
-    the points by segment and the segment index 0..m-1 of each sorted point."""
-    cells = np.floor((np.asarray(points) - origin) / length).astype(np.int64)
-    _, label = np.unique(cells, axis=0, return_inverse=True)
-    label = label.ravel()
-    W = np.bincount(label, weights=weights)
-    centre = np.stack(
-        [np.bincount(label, weights=weights * points[:, c]) / W for c in range(2)], axis=1
-    )
-    big = np.flatnonzero(W >= 0.3 * length)
-    if len(big) == 0:
-        label[:] = 0
-    else:
-        d = np.linalg.norm(centre[:, None, :] - centre[None, big, :], axis=2)
-        target = np.where(W >= 0.3 * length, np.arange(len(W)), big[np.argmin(d, axis=1)])
-        label = target[label]
-    _, label = np.unique(label, return_inverse=True)
-    order = np.argsort(label, kind="stable")
-    return order, label[order].astype(np.int32)
+def surface_chains(pieces, tol):
+    """The pieces (m, 2, 2) of a contact surface joined into chains at shared end points
+    (within tol): a list of [(piece, reversed), ...] in order along each chain."""
+    ends = np.unique(
+        np.round(pieces.reshape(-1, 2) / tol).astype(np.int64), axis=0, return_inverse=True
+    )[1].ravel()
+    at = {}
+    for k, e in enumerate(ends):
+        at.setdefault(int(e), []).append(k)  # end k = 2 piece + side
+    seen = np.zeros(len(pieces), bool)
+    degree = np.array([len(at[int(e)]) for e in ends])
+    chains = []
+    # open chains first (from an end that no other piece shares), then closed loops
+    for start in list(np.flatnonzero(degree == 1)) + list(range(len(ends))):
+        piece = start // 2
+        if seen[piece]:
+            continue
+        chain, rev = [], start % 2 == 1  # leave the start end behind
+        while not seen[piece]:
+            seen[piece] = True
+            chain.append((piece, rev))
+            far = 2 * piece + (0 if rev else 1)
+            nxt = [k for k in at[int(ends[far])] if k // 2 != piece and not seen[k // 2]]
+            if not nxt:
+                break
+            piece, rev = nxt[0] // 2, nxt[0] % 2 == 1
+        chains.append(chain)
+    return chains
+
+
+def multiplier_nodes(surface, kind, length, tol):
+    """Multiplier nodes of the contact surface's points (`_cpp.contact_surface`'s dict, points
+    filtered): along each chain of pieces (`surface_chains`), of arc length L, n = round(L /
+    length) elements of equal length; "P0": one node per element (weight 1), "P1": the hat
+    functions of the n + 1 element ends (weights 1 - theta, theta). A chain shorter than
+    length / 2 gets one node. Returns (nodes (nq, 2), weights (nq, 2)), -1 / 0 for none."""
+    if kind not in ("P0", "P1"):
+        raise ValueError(f"multipliers must be 'P0' or 'P1', got {kind!r}")
+    pieces = surface["segments"]
+    used = np.unique(surface["segment"])
+    local = np.searchsorted(used, surface["segment"])
+    arc = np.zeros(len(used))  # arc length at each piece's start, along its chain
+    start = np.zeros((len(used), 2))
+    chain_of = np.zeros(len(used), np.int64)
+    lengths = []
+    for c, chain in enumerate(surface_chains(pieces[used], tol)):
+        s = 0.0
+        for k, rev in chain:
+            a, b = pieces[used[k]][::-1] if rev else pieces[used[k]]
+            arc[k], start[k], chain_of[k] = s, a, c
+            s += np.linalg.norm(b - a)
+        lengths.append(s)
+    lengths = np.array(lengths)
+    x = surface["points"]
+    s = arc[local] + np.linalg.norm(x - start[local], axis=1)
+    c = chain_of[local]
+    n_el = np.round(lengths / length).astype(np.int64)
+    n_nodes = np.where(n_el == 0, 1, n_el + (kind == "P1"))
+    first = np.r_[0, np.cumsum(n_nodes)[:-1]]
+    nodes = np.full((len(x), 2), -1, np.int32)
+    weights = np.zeros((len(x), 2))
+    t = s / np.where(n_el[c] > 0, lengths[c] / np.maximum(n_el[c], 1), 1.0)
+    e = np.clip(np.floor(t), 0, np.maximum(n_el[c] - 1, 0)).astype(np.int64)
+    theta = np.clip(t - e, 0.0, 1.0)
+    single = n_el[c] == 0
+    nodes[:, 0] = first[c] + np.where(single, 0, e)
+    weights[:, 0] = 1.0
+    if kind == "P1":
+        hat = ~single
+        nodes[hat, 1] = nodes[hat, 0] + 1
+        weights[hat, 0], weights[hat, 1] = 1.0 - theta[hat], theta[hat]
+    # nodes that no point reaches with a positive weight (a chain end past the last point)
+    # would carry no equation: renumber the others
+    reached = np.zeros(int(n_nodes.sum()), bool)
+    reached[nodes[weights > 0]] = True
+    new = np.cumsum(reached) - 1
+    weights[nodes >= 0] = np.where(reached[nodes[nodes >= 0]], weights[nodes >= 0], 0.0)
+    nodes = np.where((nodes >= 0) & (weights > 0), new[np.maximum(nodes, 0)], -1).astype(np.int32)
+    swap = nodes[:, 0] < 0  # the first node must exist
+    nodes[swap] = nodes[swap][:, ::-1]
+    weights[swap] = weights[swap][:, ::-1]
+    return nodes, weights
 
 
 def _bbox(body):
@@ -236,7 +310,8 @@ def pair_geometry(
     projection="auto",
     obstacle=None,
     lattice_origin=None,
-    segment_length=0.0,
+    multipliers=None,
+    multiplier_length=None,
 ):
     """Contact quadrature of `pair` (indices into scene.bodies), or of body pair[0] and the
     rigid `obstacle` (pair[1] ignored): side j then has no dofs (nodes_j = 0).
@@ -247,8 +322,8 @@ def pair_geometry(
     grid_refine: level-set grid cells per mesh size h_contact.
     projection: "auto" (exact closest points on a body's analytic shape, eq 25 on the grid
     level set for a body without one) or "levelset" (eq 25 on the grid level sets for both).
-    segment_length: > 0 groups the points into segments of about that length, each with one
-    traction (`contact_segments`, on the pair-grid lattice); 0: one traction per point.
+    multipliers: None (a traction per point), "P0" or "P1": multiplier nodes along Gamma_c
+    about multiplier_length (default h) apart (`multiplier_nodes`).
     Returns None when the pair cannot touch (disjoint inflated boxes or empty Gamma_c).
     """
     if projection not in ("auto", "levelset"):
@@ -299,13 +374,10 @@ def pair_geometry(
     }
     if len(s["weights"]) == 0:
         return None
-    segments = None
-    if segment_length > 0:
-        order, segments = contact_segments(s["points"], s["weights"], segment_length, box[0])
-        s = {
-            k: (v[order] if isinstance(v, np.ndarray) and len(v) == len(order) else v)
-            for k, v in s.items()
-        }
+    mult = (None, None)
+    if multipliers is not None:
+        length = h if multiplier_length is None else multiplier_length
+        mult = multiplier_nodes(s, multipliers, length, 1e-7 * dx)
     proj = [
         closest_points(b, phi, s["points"], h, exact=projection == "auto")
         for b, phi in ((bi, phi_i), (bj, phi_j))
@@ -346,8 +418,8 @@ def pair_geometry(
     q = _cpp.ContactQuadrature(
         s["weights"], normals, tangents, g_n0, sides[0][0], sides[1][0], sides[0][1], sides[1][1]
     )
-    if segments is not None:
-        q.segments = segments
+    if mult[0] is not None:
+        q.set_multiplier_nodes(*mult)
     return PairGeometry(
         pair,
         s["points"],
@@ -361,5 +433,5 @@ def pair_geometry(
         dx,
         box,
         obstacle,
-        segments,
+        *mult,
     )

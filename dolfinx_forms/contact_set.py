@@ -7,14 +7,17 @@ g_t^p (eqs 10-12) lives in one `_cpp.FrictionHistory` per pair: the kernel reads
 committed values, each Newton iteration sets its trial values, an accepted step commits
 them and a rejected one restores them exactly.
 
+The law acts at the *law points*: the pair's multiplier nodes (`contact.multiplier_nodes`,
+each with the weighted mean gap of its points), or the points themselves without them.
+
 Enforcement: "penalty" (eqs 8, 12: the answer depends on eps) or "augmented" (augmented
-Lagrangian, Uzawa's outer loop of seed 003): per point multipliers lambda_n, lambda_t enter
+Lagrangian, Uzawa's outer loop of seed 003): multipliers lambda_n, lambda_t per law point enter
 the law as tau_n = min(0, lambda_n + g_n / eps_n) (the kernel's gap shift eps_n lambda_n) and
 tau_t,trial = lambda_t + (g_t - g_t,start) / eps_t (through the slip the kernel reads); after
-each converged Newton solve `augment` sets lambda <- tau, until the tractions stop changing.
-The fixed point has zero mean gap on every active segment and zero slip over the step on every
-sticking one, whatever eps: eps sets the speed of the loop, not the answer. The multipliers of
-a step start from the committed tractions; a rejected step restores them.
+each converged Newton solve `newton.augmented_loop` sets lambda <- tau, until the tractions
+stop changing. The fixed point has zero mean gap at every active node and zero slip over the
+step at every sticking one, whatever eps: eps sets the speed of the loop, not the answer. The
+multipliers of a step start from the committed tractions; a rejected step restores them.
 """
 
 import numpy as np
@@ -52,7 +55,8 @@ class ContactSet:
         rank=0,
         obstacles=(),
         lattice_origin=None,
-        segment_length=0.0,
+        multipliers=None,
+        multiplier_length=None,
         enforcement="penalty",
     ):
         if enforcement not in ("penalty", "augmented"):
@@ -71,7 +75,8 @@ class ContactSet:
             grid_refine=grid_refine,
             num_gauss=num_gauss,
             lattice_origin=lattice_origin,
-            segment_length=segment_length,
+            multipliers=multipliers,
+            multiplier_length=multiplier_length,
         )
         candidates = [(tuple(pair), None) for pair in scene.pairs] + [
             ((i, -1), ob)
@@ -86,14 +91,16 @@ class ContactSet:
             if g is not None:
                 self.pairs.append(g)
         self._lam = None
-        self.history = [_cpp.FrictionHistory(len(g.weights), 1) for g in self.pairs]
-        self.slip_start = [np.zeros(len(g.weights)) for g in self.pairs]
+        # friction history, slip origin and multipliers live at the law points (the multiplier
+        # nodes, or the points): `PairGeometry.num_law_points`
+        self.history = [_cpp.FrictionHistory(g.num_law_points, 1) for g in self.pairs]
+        self.slip_start = [np.zeros(g.num_law_points) for g in self.pairs]
         self.last = [None] * len(self.pairs)  # kernel output of the last evaluation
         self.committed = [None] * len(self.pairs)  # point states of the last accepted step
-        # augmented Lagrangian multipliers (per point, constant on a segment): the step's
+        # augmented Lagrangian multipliers (per law point): the step's
         # current ones and the committed tractions they start from
-        self.lambda_n = [np.zeros(len(g.weights)) for g in self.pairs]
-        self.lambda_t = [np.zeros(len(g.weights)) for g in self.pairs]
+        self.lambda_n = [np.zeros(g.num_law_points) for g in self.pairs]
+        self.lambda_t = [np.zeros(g.num_law_points) for g in self.pairs]
 
     def __len__(self):
         return len(self.pairs)
@@ -154,8 +161,8 @@ class ContactSet:
 
     def _committed_tractions(self, k):
         c = self.committed[k]
-        zero = np.zeros(len(self.pairs[k].weights))
-        return (zero, zero) if c is None else (c["tau_n"], c["tau_t"])
+        zero = np.zeros(self.pairs[k].num_law_points)
+        return (zero, zero) if c is None else (c["law_tau_n"], c["law_tau_t"])
 
     def _slip_read(self, k):
         """The slip the kernel reads: the committed one, shifted in the augmented loop so that
@@ -197,7 +204,7 @@ class ContactSet:
         return np.concatenate(parts) if parts else np.zeros(0)
 
     def set_multipliers(self, x):
-        n = [len(g.weights) for g in self.pairs]
+        n = [g.num_law_points for g in self.pairs]
         cuts = np.cumsum(n)[:-1] if n else []
         self.lambda_n = [a.copy() for a in np.split(x[: sum(n)], cuts)]
         if self.mu > 0:
@@ -206,7 +213,7 @@ class ContactSet:
     def admissible(self, x):
         """x (laid out as `multipliers`) projected on the admissible tractions: lambda_n <= 0,
         |lambda_t| <= mu |lambda_n| (an extrapolated update may leave them)."""
-        n = sum(len(g.weights) for g in self.pairs)
+        n = sum(g.num_law_points for g in self.pairs)
         x = x.copy()
         x[:n] = np.minimum(x[:n], 0.0)
         if self.mu > 0:
@@ -216,25 +223,10 @@ class ContactSet:
 
     def tractions(self):
         """The tractions of the last evaluation, laid out as `multipliers` (Uzawa's T)."""
-        parts = [s["tau_n"] for s in self.last] + (
-            [s["tau_t"] for s in self.last] if self.mu > 0 else []
+        parts = [s["law_tau_n"] for s in self.last] + (
+            [s["law_tau_t"] for s in self.last] if self.mu > 0 else []
         )
         return np.concatenate(parts) if parts else np.zeros(0)
-
-    def mean_gaps(self):
-        """Largest |mean gap| of an active segment over the last evaluation (the constraint
-        the augmented loop enforces), 0 without active segments."""
-        worst = 0.0
-        for g, s in zip(self.pairs, self.last):
-            if s is None or len(s["g_n"]) == 0:
-                continue
-            seg = g.segments if g.segments is not None else np.arange(len(g.weights))
-            W = np.bincount(seg, weights=g.weights)
-            gbar = np.bincount(seg, weights=g.weights * s["g_n"]) / W
-            active = np.bincount(seg, weights=(s["state"] > 0).astype(float)) > 0
-            if active.any():
-                worst = max(worst, np.abs(gbar[active]).max())
-        return worst
 
     def assemble(self, u, b, A=None, fd=False, fd_step=1e-9, closed_gap=0.0):
         """Add the contact residual of displacement array u to the array b (local, with
@@ -260,30 +252,29 @@ class ContactSet:
 
     def set_friction(self, mu, u):
         """Change mu between stages. Switching friction on starts from zero tangential
-        traction: the committed plastic slip is the current (segment mean) tangential gap."""
+        traction: the committed plastic slip is the current (law point) tangential gap."""
         mu = float(mu)
         if mu > 0 and self.mu == 0:
             for k, h in enumerate(self.history):
                 g = self.pairs[k]
-                gt = self._evaluate(k, u, mu=0.0)["g_t"]
-                if g.segments is not None:
-                    W = np.bincount(g.segments, weights=g.weights)
-                    gt = (np.bincount(g.segments, weights=g.weights * gt) / W)[g.segments]
-                h.trial = gt
+                h.trial = self._evaluate(k, u, mu=0.0)["law_g_t"]
                 h.commit()
-                self.lambda_t[k] = np.zeros(len(g.weights))
+                self.lambda_t[k] = np.zeros(g.num_law_points)
                 if self.committed[k] is not None:
+                    self.committed[k]["law_tau_t"] = np.zeros(g.num_law_points)
                     self.committed[k]["tau_t"] = np.zeros(len(g.weights))
                 self.slip_start[k] = h.committed
         self.mu = mu
 
     def signature(self):
         """The active set (point states), to detect Newton cycling."""
-        return tuple(s["state"].tobytes() for s in self.last if s is not None)
+        return tuple(s["law_state"].tobytes() for s in self.last if s is not None)
 
     def state_counts(self):
         states = (
-            np.concatenate([s["state"] for s in self.last]) if self.last else np.zeros(0, np.int8)
+            np.concatenate([s["law_state"] for s in self.last])
+            if self.last
+            else np.zeros(0, np.int8)
         )
         return np.bincount(states.astype(int), minlength=3)
 
@@ -295,9 +286,13 @@ class ContactSet:
             # plastic slip accumulated since friction was switched on (mu = 0: all of g_t);
             # augmented: the whole tangential gap (g_t = g_t^p + eps_t tau_t) since then, as
             # the converged stick is exact
-            slip = self.history[k].committed - self.slip_start[k] if self.mu > 0 else s["g_t"]
-            if self.mu > 0 and self.augmented:
-                slip = slip + self.eps_t * s["tau_t"]
+            if self.mu > 0:
+                slip = self.history[k].committed - self.slip_start[k]
+                if self.augmented:
+                    slip = slip + self.eps_t * s["law_tau_t"]
+                slip = g.to_points(slip)
+            else:
+                slip = s["g_t"]
             out.append(
                 dict(
                     x=g.points[:, 0],

@@ -121,6 +121,11 @@ class ImplicitMPM:
         self.reinit_drift = float(reinit_drift)
         self.timer = timer
         self.log = log if comm.rank == 0 else (lambda *a, **k: None)
+        if problem_kw.get("enforcement", "penalty") != "penalty":
+            raise ValueError(
+                "enforcement: the multi-step MPM supports 'penalty' only (its friction transfer "
+                "carries point-wise slip from step to step)"
+            )
         self.problem_kw = problem_kw
         self.points = None  # {tag: MaterialPoints}, seeded on the first scene
         self.friction = {}  # pair key -> (points (n, 2), elastic tangential gap (n,))

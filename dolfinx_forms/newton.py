@@ -33,7 +33,7 @@ class NewtonOptions:
     line_search: bool = True  # halve a Newton step that does not lower the residual
     max_backtracks: int = 5
     al_rtol: float = 1e-9
-    max_augmentations: int = 200
+    max_augmentations: int = 300
 
 
 @dataclass

@@ -47,9 +47,12 @@ class ContactProblem:
     pair_grid_origin: None, or a point through which every pair's level-set grid passes
     (`contact.pair_geometry`'s lattice_origin: symmetric scenes stay symmetric).
     enforcement: "penalty" (the answer depends on eps0) or "augmented" (augmented Lagrangian,
-    Uzawa loop, `contact_set`: eps0 sets only the loop's speed). segment_length: contact
-    points grouped into segments of about that length, one traction each (a stable pressure at
-    any eps0); None: h_contact with "augmented", point-wise (0) with "penalty".
+    Uzawa loop, `contact_set`: eps0 sets only the loop's speed). multipliers: None (a traction
+    per contact point), "P0" or "P1": one traction per multiplier node along Gamma_c, nodes
+    multiplier_length apart (`contact.multiplier_nodes`: a stable pressure at any eps0);
+    default "P1" with "augmented", None with "penalty". multiplier_length: default h body-fitted,
+    1.5 h cut (Hertz at h = a/20, P1: 0.5 h and, on the cut path, 0.75 h give a checkerboard;
+    p(x) 1.9 / 2.3 / 3.1 % body-fitted at 0.75 / 1 / 1.5 h, 3.9 / 3.4 % cut at 1 / 1.5 h).
     """
 
     def __init__(
@@ -78,7 +81,8 @@ class ContactProblem:
         predictor_gap=0.0,
         pair_grid_origin=None,
         enforcement="penalty",
-        segment_length=None,
+        multipliers="default",
+        multiplier_length=None,
         log=print,
     ):
         self.scene, self.mesh = scene, scene.mesh
@@ -144,10 +148,15 @@ class ContactProblem:
                 contact_rank,
                 obstacles,
                 pair_grid_origin,
-                segment_length=(
-                    (h if enforcement == "augmented" else 0.0)
-                    if segment_length is None
-                    else float(segment_length)
+                multipliers=(
+                    ("P1" if enforcement == "augmented" else None)
+                    if multipliers == "default"
+                    else multipliers
+                ),
+                multiplier_length=(
+                    h * (1.5 if self.integration is not None else 1.0)
+                    if multiplier_length is None
+                    else multiplier_length
                 ),
                 enforcement=enforcement,
             )

@@ -53,22 +53,40 @@ def residual(q, law, u, gtp):
     return b
 
 
-@pytest.mark.parametrize("segmented", [False, True])
+def segments(q, seg):
+    """Piecewise-constant multipliers: point p on node seg[p] alone (labels made 0..m-1)."""
+    seg = np.unique(seg, return_inverse=True)[1].ravel()
+    n = len(seg)
+    q.set_multiplier_nodes(np.c_[seg, np.full(n, -1)], np.c_[np.ones(n), np.zeros(n)])
+
+
+def hats(q, rng, elements):
+    """Piecewise-linear multipliers: point p between nodes e and e + 1 (every element holds a
+    point). Returns (nodes, weights)."""
+    e = np.r_[np.arange(elements), rng.integers(0, elements, len(q) - elements)]
+    theta = rng.uniform(0.05, 0.95, len(q))
+    nodes, weights = np.c_[e, e + 1], np.c_[1 - theta, theta]
+    q.set_multiplier_nodes(nodes, weights)
+    return nodes, weights
+
+
+@pytest.mark.parametrize("multipliers", ["points", "segments", "hats"])
 @pytest.mark.parametrize("mu", [0.0, 0.4])
-def test_tangent_equals_finite_differences(mu, segmented):
-    """Point-wise, and with the points grouped into segments of 1 to 4 points (one traction
-    per segment from its mean gaps): the tangent couples all dofs of a segment."""
+def test_tangent_equals_finite_differences(mu, multipliers):
+    """Point-wise, with the points grouped into segments (one traction per segment from its
+    mean gaps), and with hat functions (two nodes per point): the tangent couples all dofs of
+    a node's points."""
     rng = np.random.default_rng(3)
-    q = make_quadrature(rng, nq=120 if segmented else 40)
-    if segmented:
-        q.segments = np.sort(rng.integers(0, 40, len(q))).astype(np.int32)
+    q = make_quadrature(rng, nq=40 if multipliers == "points" else 120)
+    if multipliers == "segments":
+        segments(q, rng.integers(0, 40, len(q)))
+    elif multipliers == "hats":
+        hats(q, rng, 30)
     law = (1e-2, 2e-2, mu)
     u = rng.uniform(-0.02, 0.02, 2 * NNODES)
-    gtp = rng.uniform(-0.01, 0.01, len(q)) if mu > 0 else np.zeros(0)
-    if segmented and mu > 0:  # one committed slip per segment, as the solver keeps it
-        gtp = gtp[np.searchsorted(q.segments, q.segments)]
+    gtp = rng.uniform(-0.01, 0.01, q.num_law_points) if mu > 0 else np.zeros(0)
     K, b, s = dense_tangent(q, law, u, gtp)
-    states = np.bincount(s["state"], minlength=3)
+    states = np.bincount(s["law_state"], minlength=3)
     if mu > 0:
         assert np.all(states > 0), f"open/stick/slip all needed, got {states}"
     else:
@@ -114,39 +132,39 @@ def test_mu_zero_touches_no_history():
     assert np.all(s["tau_t"] == 0)
 
 
-def test_segment_traction_is_the_law_of_its_mean_gap():
-    """A segment's traction is Algorithm 1 on the weighted mean of its points' gaps (plus the
-    augmented Lagrangian's shift), the same on all its points; its residual is the sum of the
-    points' w B^T tau; single-point segments reproduce the point-wise kernel exactly."""
+def test_node_traction_is_the_law_of_its_mean_gap():
+    """A node's traction is Algorithm 1 on the psi-weighted mean of its points' gaps (plus
+    the augmented Lagrangian's shift); a point's traction is sum psi tau of its nodes; the
+    residual is sum_p w_p B_p^T tau_p; single-point nodes reproduce the point-wise kernel."""
     rng = np.random.default_rng(11)
     q = make_quadrature(rng, nq=30)
     u = rng.uniform(-0.02, 0.02, 2 * NNODES)
-    gtp = np.zeros(len(q))
     eps_n, eps_t, mu = 1e-2, 2e-2, 0.3
-    point = _cpp.assemble_contact(q, eps_n, eps_t, mu, u, gtp)
-    b_point = residual(q, (eps_n, eps_t, mu), u, gtp)
-    q.segments = np.arange(len(q), dtype=np.int32)
-    single = _cpp.assemble_contact(q, eps_n, eps_t, mu, u, gtp)
+    point = _cpp.assemble_contact(q, eps_n, eps_t, mu, u, np.zeros(30))
+    b_point = residual(q, (eps_n, eps_t, mu), u, np.zeros(30))
+    segments(q, np.arange(30))
+    single = _cpp.assemble_contact(q, eps_n, eps_t, mu, u, np.zeros(30))
     np.testing.assert_array_equal(single["tau_n"], point["tau_n"])
-    np.testing.assert_array_equal(residual(q, (eps_n, eps_t, mu), u, gtp), b_point)
+    np.testing.assert_array_equal(residual(q, (eps_n, eps_t, mu), u, np.zeros(30)), b_point)
 
-    q.segments = np.repeat(np.arange(10), 3).astype(np.int32)
-    shift = np.repeat(rng.uniform(-0.01, 0, 10), 3)
-    s = _cpp.assemble_contact(q, eps_n, eps_t, mu, u, gtp, g_n_shift=shift)
-    w = q.weights
-    for k in range(10):
-        sl = slice(3 * k, 3 * k + 3)
-        gn = np.sum(w[sl] * point["g_n"][sl]) / w[sl].sum() + shift[3 * k]
-        gt = np.sum(w[sl] * point["g_t"][sl]) / w[sl].sum()
+    nodes, w = hats(q, rng, 7)
+    shift = rng.uniform(-0.01, 0, 8)
+    s = _cpp.assemble_contact(q, eps_n, eps_t, mu, u, np.zeros(8), g_n_shift=shift)
+    W = q.weights[:, None] * w
+    for a in range(8):
+        m = W * (nodes == a)
+        gn = np.sum(m.sum(1) * point["g_n"]) / m.sum() + shift[a]
+        gt = np.sum(m.sum(1) * point["g_t"]) / m.sum()
         tn = min(gn, 0.0) / eps_n
-        np.testing.assert_allclose(s["tau_n"][sl], tn, rtol=1e-12, atol=1e-300)
-        if tn < 0:
-            tt = gt / eps_t
-            tt = tt if abs(tt) <= mu * abs(tn) else mu * abs(tn) * np.sign(tt)
-            np.testing.assert_allclose(s["tau_t"][sl], tt, rtol=1e-12)
-        np.testing.assert_array_equal(s["g_n"][sl], point["g_n"][sl])  # the points' own gaps
-    assert np.any(s["tau_n"] < 0) and np.any(s["tau_n"] == 0)
+        np.testing.assert_allclose(s["law_tau_n"][a], tn, rtol=1e-12, atol=1e-300)
+        tt = gt / eps_t if tn < 0 else 0.0
+        tt = tt if abs(tt) <= mu * abs(tn) else mu * abs(tn) * np.sign(tt)
+        np.testing.assert_allclose(s["law_tau_t"][a], tt, rtol=1e-12, atol=1e-300)
+    tau_p = np.sum(w * s["law_tau_n"][nodes], axis=1)
+    np.testing.assert_allclose(s["tau_n"], tau_p, rtol=1e-12, atol=1e-300)
+    np.testing.assert_array_equal(s["g_n"], point["g_n"])  # the points' own gaps
+    assert np.any(s["law_tau_n"] < 0) and np.any(s["law_tau_n"] == 0)
     blocks = q.coupling_dofs()
-    assert len(blocks) == 10 and all(len(np.unique(b)) == len(b) for b in blocks)
-    with pytest.raises(ValueError, match="non-decreasing"):
-        q.segments = np.arange(len(q), dtype=np.int32)[::-1].copy()
+    assert len(blocks) == 8 and all(len(np.unique(b)) == len(b) for b in blocks)
+    with pytest.raises(ValueError, match="sum to 1"):
+        q.set_multiplier_nodes(np.zeros((30, 2), np.int32), np.full((30, 2), 0.7))

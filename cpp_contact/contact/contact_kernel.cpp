@@ -67,41 +67,79 @@ void ContactQuadrature::validate() const {
   check(basis_j.size(), nq * nodes_j, "basis_j");
   if (!u_j_prescribed.empty())
     check(u_j_prescribed.size(), 2 * nq, "u_j_prescribed");
-  if (!segments.empty()) {
-    check(segments.size(), nq, "segments");
-    if (!std::is_sorted(segments.begin(), segments.end()))
-      throw std::invalid_argument("ContactQuadrature: segments must be non-decreasing");
+  if (!mult_nodes.empty() or !mult_weights.empty()) {
+    check(mult_nodes.size(), 2 * nq, "mult_nodes");
+    check(mult_weights.size(), 2 * nq, "mult_weights");
+    for (std::size_t p = 0; p < nq; ++p) {
+      if (mult_nodes[2 * p] < 0)
+        throw std::invalid_argument("ContactQuadrature: every point needs a first node");
+      const double w0 = mult_weights[2 * p];
+      const double w1 = mult_nodes[2 * p + 1] < 0 ? 0.0 : mult_weights[2 * p + 1];
+      if (!(w0 >= 0) or !(w1 >= 0) or std::abs(w0 + w1 - 1.0) > 1e-12)
+        throw std::invalid_argument("ContactQuadrature: a point's node weights must be >= 0 "
+                                    "and sum to 1");
+    }
   }
 }
 
 //-----------------------------------------------------------------------------
-std::vector<std::size_t> ContactQuadrature::segment_offsets() const {
-  std::vector<std::size_t> offsets = {0};
-  for (std::size_t p = 1; p <= size(); ++p)
-    if (segments.empty() or p == size() or segments[p] != segments[p - 1])
-      offsets.push_back(p);
-  if (size() == 0)
-    offsets.resize(1);
-  return offsets;
+std::size_t ContactQuadrature::num_law_points() const {
+  if (mult_nodes.empty())
+    return size();
+  return std::size_t(*std::max_element(mult_nodes.begin(), mult_nodes.end()) + 1);
+}
+
+//-----------------------------------------------------------------------------
+ContactQuadrature::LawPoints ContactQuadrature::law_points() const {
+  const std::size_t nq = size(), na = num_law_points();
+  LawPoints lp;
+  lp.offsets.assign(na + 1, 0);
+  if (mult_nodes.empty()) {
+    for (std::size_t p = 0; p < nq; ++p) {
+      lp.offsets[p + 1] = p + 1;
+      lp.points.push_back(std::int32_t(p));
+      lp.psi.push_back(1.0);
+    }
+    return lp;
+  }
+  // counting sort of the (node, point) entries with a positive weight
+  for (std::size_t k = 0; k < 2 * nq; ++k)
+    if (mult_nodes[k] >= 0 and mult_weights[k] > 0)
+      ++lp.offsets[std::size_t(mult_nodes[k]) + 1];
+  for (std::size_t a = 0; a < na; ++a)
+    lp.offsets[a + 1] += lp.offsets[a];
+  lp.points.resize(lp.offsets[na]);
+  lp.psi.resize(lp.offsets[na]);
+  std::vector<std::size_t> next(lp.offsets.begin(), lp.offsets.end() - 1);
+  for (std::size_t k = 0; k < 2 * nq; ++k) {
+    if (mult_nodes[k] >= 0 and mult_weights[k] > 0) {
+      const std::size_t j = next[std::size_t(mult_nodes[k])]++;
+      lp.points[j] = std::int32_t(k / 2);
+      lp.psi[j] = mult_weights[k];
+    }
+  }
+  return lp;
 }
 
 namespace {
-/// Block dofs of the points [p0, p1) without repeats, and each point's positions in that list
-/// (nd per point).
-void segment_dofs(const ContactQuadrature& q, std::size_t p0, std::size_t p1,
-                  std::vector<std::int32_t>& sdofs, std::vector<std::size_t>& where) {
+/// Block dofs of the points of law point a without repeats, and each entry's positions in that
+/// list (nd per entry).
+void law_point_dofs(const ContactQuadrature& q, const ContactQuadrature::LawPoints& lp,
+                    std::size_t a, std::vector<std::int32_t>& sdofs,
+                    std::vector<std::size_t>& where) {
   const std::size_t nd = q.nodes_i + q.nodes_j;
   std::vector<std::int32_t> dofs(nd);
   std::vector<double> N(nd);
   sdofs.clear();
-  where.resize((p1 - p0) * nd);
-  for (std::size_t p = p0; p < p1; ++p) {
-    point_basis(q, p, dofs, N);
-    for (std::size_t a = 0; a < nd; ++a) {
-      auto it = std::find(sdofs.begin(), sdofs.end(), dofs[a]);
-      where[(p - p0) * nd + a] = std::size_t(it - sdofs.begin());
+  const std::size_t k0 = lp.offsets[a], k1 = lp.offsets[a + 1];
+  where.resize((k1 - k0) * nd);
+  for (std::size_t k = k0; k < k1; ++k) {
+    point_basis(q, std::size_t(lp.points[k]), dofs, N);
+    for (std::size_t i = 0; i < nd; ++i) {
+      auto it = std::find(sdofs.begin(), sdofs.end(), dofs[i]);
+      where[(k - k0) * nd + i] = std::size_t(it - sdofs.begin());
       if (it == sdofs.end())
-        sdofs.push_back(dofs[a]);
+        sdofs.push_back(dofs[i]);
     }
   }
 }
@@ -110,13 +148,13 @@ void segment_dofs(const ContactQuadrature& q, std::size_t p0, std::size_t p1,
 //-----------------------------------------------------------------------------
 CouplingBlocks coupling_dofs(const ContactQuadrature& q) {
   q.validate();
-  const std::vector<std::size_t> offsets = q.segment_offsets();
+  const ContactQuadrature::LawPoints lp = q.law_points();
   CouplingBlocks blocks;
   blocks.offsets = {0};
   std::vector<std::int32_t> sdofs;
   std::vector<std::size_t> where;
-  for (std::size_t s = 0; s + 1 < offsets.size(); ++s) {
-    segment_dofs(q, offsets[s], offsets[s + 1], sdofs, where);
+  for (std::size_t a = 0; a + 1 < lp.offsets.size(); ++a) {
+    law_point_dofs(q, lp, a, sdofs, where);
     blocks.dofs.insert(blocks.dofs.end(), sdofs.begin(), sdofs.end());
     blocks.offsets.push_back(blocks.dofs.size());
   }
@@ -133,11 +171,11 @@ ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPena
   if (!(law.eps_n > 0) or !(law.eps_t > 0) or !(law.mu >= 0) or !std::isfinite(law.mu))
     throw std::invalid_argument("assemble_contact: need eps_n > 0, eps_t > 0, finite mu >= 0");
   const bool friction = law.mu > 0.0;
-  const std::size_t nq = q.size();
-  if (friction and gtp_old.size() != nq)
-    throw std::invalid_argument("assemble_contact: gtp_old must have one value per point");
-  if (!g_n_shift.empty() and g_n_shift.size() != nq)
-    throw std::invalid_argument("assemble_contact: g_n_shift must be empty or one per point");
+  const std::size_t nq = q.size(), na = q.num_law_points();
+  if (friction and gtp_old.size() != na)
+    throw std::invalid_argument("assemble_contact: gtp_old must have one value per law point");
+  if (!g_n_shift.empty() and g_n_shift.size() != na)
+    throw std::invalid_argument("assemble_contact: g_n_shift must be empty or one per law point");
   if (!b.empty() and b.size() != u.size())
     throw std::invalid_argument("assemble_contact: b must have the size of u");
   if (mode == TangentMode::finite_difference and !(fd_step > 0))
@@ -147,88 +185,112 @@ ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPena
   ContactPointState s;
   s.g_n.resize(nq);
   s.g_t.resize(nq);
-  s.tau_n.resize(nq);
-  s.tau_t.resize(nq);
-  s.state.resize(nq);
+  s.tau_n.assign(nq, 0.0);
+  s.tau_t.assign(nq, 0.0);
+  s.state.assign(nq, ContactState::open);
+  s.law_g_n.resize(na);
+  s.law_g_t.resize(na);
+  s.law_tau_n.resize(na);
+  s.law_tau_t.resize(na);
+  s.law_state.resize(na);
   if (friction)
-    s.gtp_trial.resize(nq);
+    s.gtp_trial.resize(na);
 
-  const std::vector<std::size_t> offsets = q.segment_offsets();
+  // The points' gaps (eq 26: the jump u_j(P_j) - u_i(P_i); eqs 27-30)
   std::vector<std::int32_t> dofs(nd), sdofs;
   std::vector<std::size_t> where;
   std::vector<double> N(nd), bn, bt, Ke, rp, rm;
-  for (std::size_t seg = 0; seg + 1 < offsets.size(); ++seg) {
-    const std::size_t p0 = offsets[seg], p1 = offsets[seg + 1];
-    segment_dofs(q, p0, p1, sdofs, where);
+  for (std::size_t p = 0; p < nq; ++p) {
+    point_basis(q, p, dofs, N);
+    std::array<double, 2> du = {0.0, 0.0};
+    for (std::size_t i = 0; i < nd; ++i)
+      for (std::size_t c = 0; c < 2; ++c)
+        du[c] += N[i] * u[2 * std::size_t(dofs[i]) + c];
+    if (!q.u_j_prescribed.empty())
+      for (std::size_t c = 0; c < 2; ++c)
+        du[c] += q.u_j_prescribed[2 * p + c];
+    const PointGaps gaps =
+        point_gaps(q.g_n0[p], du, std::span<const double, 2>(&q.normals[2 * p], 2),
+                   std::span<const double, 2>(&q.tangents[2 * p], 2));
+    s.g_n[p] = gaps.g_n;
+    s.g_t[p] = gaps.g_t;
+  }
+
+  const ContactQuadrature::LawPoints lp = q.law_points();
+  std::vector<double> heaviest(nq, -1.0); // the largest psi seen per point (its state's node)
+  for (std::size_t a = 0; a < na; ++a) {
+    const std::size_t k0 = lp.offsets[a], k1 = lp.offsets[a + 1];
+    if (k0 == k1)
+      throw std::invalid_argument("assemble_contact: multiplier node " + std::to_string(a) +
+                                  " has no points");
+    law_point_dofs(q, lp, a, sdofs, where);
     const std::size_t ne = 2 * sdofs.size();
     bn.assign(ne, 0.0);
     bt.assign(ne, 0.0);
-    // b_n = sum_p w_p B_n,p and b_t likewise (B rows: jump of u projected on n and t), and the
-    // weighted sums of the points' gaps
-    double W = 0.0, wgn = 0.0, wgt = 0.0, wgtp = 0.0, wshift = 0.0;
-    for (std::size_t p = p0; p < p1; ++p) {
+    // b_n = sum_p w_p psi_p B_n,p and b_t likewise (B rows: the jump projected on n and t), and
+    // the weighted sums of the points' gaps
+    double W = 0.0, wgn = 0.0, wgt = 0.0;
+    for (std::size_t k = k0; k < k1; ++k) {
+      const std::size_t p = std::size_t(lp.points[k]);
       point_basis(q, p, dofs, N);
       const double* n = &q.normals[2 * p];
       const double* t = &q.tangents[2 * p];
-      const double w = q.weights[p];
-      // Displacement jump u_j(P_j) - u_i(P_i) (eq 26) and the gaps (eqs 27-30)
-      std::array<double, 2> du = {0.0, 0.0};
-      for (std::size_t a = 0; a < nd; ++a) {
-        const std::size_t k = where[(p - p0) * nd + a];
+      const double w = q.weights[p] * lp.psi[k];
+      for (std::size_t i = 0; i < nd; ++i) {
+        const std::size_t j = where[(k - k0) * nd + i];
         for (std::size_t c = 0; c < 2; ++c) {
-          du[c] += N[a] * u[2 * std::size_t(dofs[a]) + c];
-          bn[2 * k + c] += w * N[a] * n[c];
-          bt[2 * k + c] += w * N[a] * t[c];
+          bn[2 * j + c] += w * N[i] * n[c];
+          bt[2 * j + c] += w * N[i] * t[c];
         }
       }
-      if (!q.u_j_prescribed.empty())
-        for (std::size_t c = 0; c < 2; ++c)
-          du[c] += q.u_j_prescribed[2 * p + c];
-      const PointGaps gaps = point_gaps(q.g_n0[p], du, std::span<const double, 2>(n, 2),
-                                        std::span<const double, 2>(t, 2));
-      s.g_n[p] = gaps.g_n;
-      s.g_t[p] = gaps.g_t;
       W += w;
-      wgn += w * gaps.g_n;
-      wgt += w * gaps.g_t;
-      wgtp += friction ? w * gtp_old[p] : 0.0;
-      wshift += g_n_shift.empty() ? 0.0 : w * g_n_shift[p];
+      wgn += w * s.g_n[p];
+      wgt += w * s.g_t[p];
     }
-    // the law on the segment's mean gaps (a single point: its own, exactly)
-    const bool single = p1 - p0 == 1;
-    const double gn = (single ? s.g_n[p0] : wgn / W) +
-                      (g_n_shift.empty() ? 0.0 : (single ? g_n_shift[p0] : wshift / W));
-    const double gt = single ? s.g_t[p0] : wgt / W;
-    const double gtp0 = friction ? (single ? gtp_old[p0] : wgtp / W) : 0.0;
+    // the law on the mean gaps (a single point of weight 1: its own, exactly)
+    const std::size_t p0 = std::size_t(lp.points[k0]);
+    const bool single = k1 - k0 == 1 and lp.psi[k0] == 1.0;
+    s.law_g_n[a] = single ? s.g_n[p0] : wgn / W;
+    s.law_g_t[a] = single ? s.g_t[p0] : wgt / W;
+    const double gn = s.law_g_n[a] + (g_n_shift.empty() ? 0.0 : g_n_shift[a]);
+    const double gt = s.law_g_t[a];
+    const double gtp0 = friction ? gtp_old[a] : 0.0;
     double tau_n, tau_t, gtp = 0.0;
     ContactState state;
     std::array<double, 4> D;
     point_law(law, gn, gt, gtp0, tau_n, tau_t, gtp, state, D);
-    for (std::size_t p = p0; p < p1; ++p) {
-      s.tau_n[p] = tau_n;
-      s.tau_t[p] = tau_t;
-      s.state[p] = state;
-      if (friction)
-        s.gtp_trial[p] = gtp;
+    s.law_tau_n[a] = tau_n;
+    s.law_tau_t[a] = tau_t;
+    s.law_state[a] = state;
+    if (friction)
+      s.gtp_trial[a] = gtp;
+    for (std::size_t k = k0; k < k1; ++k) {
+      const std::size_t p = std::size_t(lp.points[k]);
+      s.tau_n[p] += lp.psi[k] * tau_n;
+      s.tau_t[p] += lp.psi[k] * tau_t;
+      if (lp.psi[k] > heaviest[p]) {
+        heaviest[p] = lp.psi[k];
+        s.state[p] = state;
+      }
     }
     bool predictor = false;
     if (state == ContactState::open) {
-      // A touching segment (0 <= g_n < closed_gap) lends the tangent of a closed, sticking one
+      // A touching node (0 <= g_n < closed_gap) lends the tangent of a closed, sticking one
       // (no traction): the predictor of a step whose bodies are held by contacts not yet closed
       if (!insert or !(gn < closed_gap))
         continue;
       predictor = true;
       D = {1.0 / law.eps_n, 0.0, 0.0, friction ? 1.0 / law.eps_t : 0.0};
     } else if (closed_gap > 0 and state == ContactState::slip and friction) {
-      // ... and in that predictor a slipping segment sticks: a grain whose contacts all slip
+      // ... and in that predictor a slipping node sticks: a grain whose contacts all slip
       // has no tangential stiffness in its first iterate (the residual stays exact)
       D = {1.0 / law.eps_n, 0.0, 0.0, 1.0 / law.eps_t};
     }
 
     if (!b.empty() and !predictor) {
-      for (std::size_t k = 0; k < sdofs.size(); ++k)
+      for (std::size_t j = 0; j < sdofs.size(); ++j)
         for (std::size_t c = 0; c < 2; ++c)
-          b[2 * std::size_t(sdofs[k]) + c] += bn[2 * k + c] * tau_n + bt[2 * k + c] * tau_t;
+          b[2 * std::size_t(sdofs[j]) + c] += bn[2 * j + c] * tau_n + bt[2 * j + c] * tau_t;
     }
     if (!insert)
       continue;
@@ -243,7 +305,7 @@ ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPena
           Ke[r * ne + c] = dn * bn[c] + dt * bt[c];
       }
     } else {
-      // Central differences of the segment residual r(u_e) = [b_n b_t] tau(gbar(u_e))
+      // Central differences of the law point's residual r(u_e) = [b_n b_t] tau(gbar(u_e))
       rp.resize(ne);
       rm.resize(ne);
       auto residual = [&](double djn, double djt, std::span<double> r) {

@@ -32,27 +32,43 @@ struct ContactQuadrature {
   /// (nq, 2) displacement of side j at P_j not carried by dofs (a rigid obstacle's prescribed
   /// motion), added to u_j(P_j) in the jump of eq 26; empty: none
   std::vector<double> u_j_prescribed;
-  /// (nq,) non-decreasing segment index of each point; empty: every point is its own segment.
-  /// A segment carries one traction (one multiplier, a piecewise-constant pressure): the law
-  /// sees the weighted mean of its points' gaps, so the constraints are as many as the
-  /// segments, not as the points (no over-constraint of the P1/Q1 trace, stable pressure).
-  std::vector<std::int32_t> segments;
+  /// Multiplier nodes (optional; empty: every point carries its own traction). Point p
+  /// belongs to node mult_nodes[2p] with weight mult_weights[2p] and to mult_nodes[2p + 1]
+  /// (-1: none) with mult_weights[2p + 1]; a point's weights sum to 1 (a partition of unity
+  /// along Gamma_c: one node of weight 1 for piecewise-constant segments, two hat values for a
+  /// piecewise-linear pressure). A node carries one traction from the psi-weighted mean of its
+  /// points' gaps, so the constraints are as many as the nodes, not as the points (no
+  /// over-constraint of the P1/Q1 trace: a stable pressure).
+  std::vector<std::int32_t> mult_nodes;
+  std::vector<double> mult_weights;
 
   /// @brief Number of quadrature points.
   std::size_t size() const { return weights.size(); }
   /// @brief Check that all arrays have consistent sizes.
   /// @throws std::invalid_argument naming the first inconsistent array
   void validate() const;
-  /// @brief Point ranges: segment s holds the points [offsets[s], offsets[s + 1]).
-  std::vector<std::size_t> segment_offsets() const;
+  /// @brief Where the law acts: the multiplier nodes, or the points without them.
+  std::size_t num_law_points() const;
+  /// @brief For each law point, its points and their weights psi (CSR: law point a has
+  /// points[offsets[a], offsets[a + 1]) with psi likewise).
+  struct LawPoints {
+    std::vector<std::size_t> offsets;
+    std::vector<std::int32_t> points;
+    std::vector<double> psi;
+  };
+  LawPoints law_points() const;
 };
 
-/// @brief Traction state of every quadrature point after an evaluation.
+/// @brief Traction state after an evaluation, at the points and at the law points (the
+/// multiplier nodes, or the points themselves without them).
 struct ContactPointState {
-  std::vector<double> g_n, g_t;     ///< gaps (eqs 27, 30)
-  std::vector<double> tau_n, tau_t; ///< tractions (compression negative)
-  std::vector<double> gtp_trial;    ///< plastic slip after this evaluation
-  std::vector<ContactState> state;  ///< open / stick / slip
+  std::vector<double> g_n, g_t;             ///< the points' gaps (eqs 27, 30)
+  std::vector<double> tau_n, tau_t;         ///< the points' tractions, sum_a psi_a tau_a
+  std::vector<ContactState> state;          ///< the points' state: that of their heaviest node
+  std::vector<double> law_g_n, law_g_t;     ///< law points' mean gaps
+  std::vector<double> law_tau_n, law_tau_t; ///< law points' tractions (compression negative)
+  std::vector<ContactState> law_state;      ///< law points' state: open / stick / slip
+  std::vector<double> gtp_trial;            ///< law points' plastic slip after this evaluation
 };
 
 /// @brief Callback receiving one point's element matrix: block dofs (nodes_i + nodes_j) and the
@@ -66,11 +82,11 @@ enum class TangentMode { exact, finite_difference };
 
 /// @brief Contact residual and tangent of eq 48 for a body pair.
 ///
-/// Per segment S (a single point unless q.segments groups them), with weights w_p, W = sum w_p:
-/// the law (Algorithm 1) acts on the mean gaps gbar = sum w_p g_p / W (+ the mean shift), its
-/// tractions hold on every point of S, r += sum_p w_p B_p^T tau = [b_n b_t] tau with
-/// b = sum_p w_p B_p, and K += (1/W) [b_n b_t] D [b_n b_t]^T: the exact derivative. For a
-/// single point this is the point-wise form below.
+/// Per law point a (a multiplier node, or a single point without them), with its points'
+/// weights w_p psi_p, W = sum w_p psi_p: the law (Algorithm 1) acts on the mean gaps
+/// gbar = sum w_p psi_p g_p / W (+ the shift), r += sum_p w_p psi_p B_p^T tau_a
+/// = [b_n b_t] tau_a with b = sum_p w_p psi_p B_p, and K += (1/W) [b_n b_t] D [b_n b_t]^T:
+/// the exact derivative. For a single point of weight 1 this is the point-wise form below.
 /// At each point: g_n = g_n0 + (u_j(P_j) - u_i(P_i)).n, g_t = (u_j - u_i).t (`point_gaps`,
 /// u_j(P_j) including q.u_j_prescribed;
 /// gaps.h, with u interpolated at P_i and P_j by the basis values), the return
@@ -81,7 +97,8 @@ enum class TangentMode { exact, finite_difference };
 /// @param[in] q Quadrature of the pair
 /// @param[in] law Penalty compliances and friction coefficient
 /// @param[in] u Local displacement array (block size 2, owned + ghost)
-/// @param[in] gtp_old Committed plastic slip (nq), ignored (may be empty) when mu == 0
+/// @param[in] gtp_old Committed plastic slip (one per law point), ignored (may be empty) when
+/// mu == 0
 /// @param[out] b Local residual array to add to (size of u), or empty to skip
 /// @param[in] insert Receives element matrices, or empty to skip the tangent
 /// @param[in] mode Exact or finite-difference tangent
@@ -90,20 +107,21 @@ enum class TangentMode { exact, finite_difference };
 /// add the tangent of a closed, sticking point (and no residual), slipping points the sticking
 /// tangent: for bodies held only by contacts that touch but are not yet closed, or that all
 /// slip in a first iterate far from equilibrium (0: off, the exact tangent)
-/// @param[in] g_n_shift (nq) added to the normal gap the law sees, or empty: the augmented
+/// @param[in] g_n_shift (one per law point) added to the normal gap the law sees, or empty: the
+/// augmented
 /// Lagrangian's multiplier, eps_n lambda_n, so that tau_n = min(0, lambda_n + g_n / eps_n)
 /// (Uzawa, seed 003); the reported g_n stays the true gap
-/// @return Per-point gaps (the points' own), tractions, trial slip and states (their segment's)
+/// @return Gaps, tractions and states at the points and the law points, trial slip
 ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPenalty& law,
                                    std::span<const double> u, std::span<const double> gtp_old,
                                    std::span<double> b, const BlockInserter& insert,
                                    TangentMode mode = TangentMode::exact, double fd_step = 1e-8,
                                    double closed_gap = 0.0, std::span<const double> g_n_shift = {});
 
-/// @brief Coupling blocks of a pair, one per segment: the block dofs of all its points.
+/// @brief Coupling blocks of a pair, one per law point: the block dofs of all its points.
 struct CouplingBlocks {
-  std::vector<std::int32_t> dofs;   ///< block dofs, segment after segment (no repeats within)
-  std::vector<std::size_t> offsets; ///< segment s: dofs[offsets[s], offsets[s + 1])
+  std::vector<std::int32_t> dofs;   ///< block dofs, law point after law point (no repeats within)
+  std::vector<std::size_t> offsets; ///< law point a: dofs[offsets[a], offsets[a + 1])
 };
 
 /// @brief The coupling blocks that the sparsity pattern must contain.

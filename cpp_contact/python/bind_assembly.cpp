@@ -82,24 +82,30 @@ void bind_assembly(py::module_& m) {
           },
           "(nq, 2) displacement of side j at P_j not carried by dofs (rigid obstacle motion), "
           "added to u_j(P_j) in the gaps; empty: none")
-      .def_property(
-          "segments",
-          [](const ContactQuadrature& q) {
-            return to_numpy(std::vector<std::int32_t>(q.segments),
-                            {py::ssize_t(q.segments.size())});
-          },
-          [](ContactQuadrature& q, const iarray& v) {
-            std::vector<std::int32_t> old = q.segments;
-            q.segments = copy_of(v);
+      .def(
+          "set_multiplier_nodes",
+          [](ContactQuadrature& q, const iarray& nodes, const carray& weights) {
+            if (nodes.ndim() != 2 or nodes.shape(1) != 2 or weights.ndim() != 2 or
+                weights.shape(1) != 2)
+              throw std::invalid_argument("nodes, weights: expected arrays of shape (nq, 2)");
+            std::vector<std::int32_t> old_n = q.mult_nodes;
+            std::vector<double> old_w = q.mult_weights;
+            q.mult_nodes = copy_of(nodes);
+            q.mult_weights = copy_of(weights);
             try {
               q.validate();
             } catch (...) {
-              q.segments = old;
+              q.mult_nodes = old_n;
+              q.mult_weights = old_w;
               throw;
             }
           },
-          "(nq,) non-decreasing segment index of each point (one traction per segment); empty: "
-          "point-wise")
+          py::arg("nodes"), py::arg("weights"),
+          "Multiplier nodes: point p belongs to nodes[p, 0] with weights[p, 0] and to nodes[p, 1] "
+          "(-1: none) with weights[p, 1], the weights of a point summing to 1; each node carries "
+          "one traction from the weighted mean of its points' gaps")
+      .def_property_readonly("num_law_points", &ContactQuadrature::num_law_points,
+                             "Multiplier nodes, or points without them: where the law acts")
       .def(
           "coupling_dofs",
           [](const ContactQuadrature& q) {
@@ -111,7 +117,7 @@ void bind_assembly(py::module_& m) {
                                   {py::ssize_t(c.offsets[s + 1] - c.offsets[s])}));
             return out;
           },
-          "Block dofs coupled by each segment (a list, one array per segment)");
+          "Block dofs coupled by each law point (a list, one array per law point)");
 
   m.def(
       "insert_coupling",
@@ -124,7 +130,8 @@ void bind_assembly(py::module_& m) {
         }
       },
       py::arg("pattern"), py::arg("quadrature"),
-      "Add the contact coupling blocks of every segment to a (not yet assembled) SparsityPattern");
+      "Add the contact coupling blocks of every law point to a (not yet assembled) "
+      "SparsityPattern");
 
   m.def(
       "add_coupling_zeros",
@@ -172,18 +179,27 @@ void bind_assembly(py::module_& m) {
             q, contact::CoulombPenalty{eps_n, eps_t, mu}, as_span(u, "u"),
             as_span(gtp_old, "gtp_old"), bs, insert, mode, fd_step, closed_gap,
             g_n_shift ? as_span(*g_n_shift, "g_n_shift") : std::span<const double>());
-        const auto nq = py::ssize_t(q.size());
-        std::vector<std::int8_t> st(s.state.size());
-        for (std::size_t p = 0; p < st.size(); ++p)
-          st[p] = std::int8_t(s.state[p]);
+        const auto nq = py::ssize_t(q.size()), na = py::ssize_t(q.num_law_points());
+        auto int8 = [](const std::vector<contact::ContactState>& v) {
+          std::vector<std::int8_t> out(v.size());
+          for (std::size_t p = 0; p < v.size(); ++p)
+            out[p] = std::int8_t(v[p]);
+          return out;
+        };
+        std::vector<std::int8_t> st = int8(s.state);
         py::dict d;
+        d["law_g_n"] = to_numpy(std::move(s.law_g_n), {na});
+        d["law_g_t"] = to_numpy(std::move(s.law_g_t), {na});
+        d["law_tau_n"] = to_numpy(std::move(s.law_tau_n), {na});
+        d["law_tau_t"] = to_numpy(std::move(s.law_tau_t), {na});
+        d["law_state"] = to_numpy(int8(s.law_state), {na});
         d["g_n"] = to_numpy(std::move(s.g_n), {nq});
         d["g_t"] = to_numpy(std::move(s.g_t), {nq});
         d["tau_n"] = to_numpy(std::move(s.tau_n), {nq});
         d["tau_t"] = to_numpy(std::move(s.tau_t), {nq});
         d["state"] = to_numpy(std::move(st), {nq});
         if (mu > 0)
-          d["gtp_trial"] = to_numpy(std::move(s.gtp_trial), {nq});
+          d["gtp_trial"] = to_numpy(std::move(s.gtp_trial), {na});
         else
           d["gtp_trial"] = py::none();
         return d;
@@ -194,7 +210,8 @@ void bind_assembly(py::module_& m) {
       py::arg("g_n_shift") = py::none(),
       "Contact residual (added into the local array b) and tangent (added into the PETSc Mat A "
       "by local block indices; call A.assemble() after) of eq 48. Returns a dict of per-point "
-      "g_n, g_t, tau_n, tau_t, state (int8 ContactState) and gtp_trial (None when mu == 0); "
-      "tractions, states and gtp_trial are their segment's. g_n_shift: eps_n lambda_n of the "
-      "augmented Lagrangian (added to the gap the law sees), or None.");
+      "g_n, g_t, tau_n, tau_t, state (int8 ContactState), of law points (multiplier nodes, or "
+      "the points) law_g_n, law_g_t, law_tau_n, law_tau_t, law_state, and their gtp_trial "
+      "(None when mu == 0). gtp_old and g_n_shift (eps_n lambda_n of the augmented "
+      "Lagrangian, added to the gap the law sees, or None) are per law point.");
 }
