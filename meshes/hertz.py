@@ -63,8 +63,10 @@ def _build(gmsh, R, W, depth, z, h, h_far, quads, Ry=None):
     grids with edges <= h, the rest is recombined. Triangles: unstructured everywhere.
     Ry: vertical semi-axis of the indenter (default R, the circle)."""
     Ry = R if Ry is None else Ry
-    geo, sag = gmsh.model.geo, ellipse_sag(R, Ry, z)
-    assert 0 < z < min(R, Ry, W, depth) and sag < z, "zone must lie inside both bodies"
+    geo = gmsh.model.geo
+    assert 0 < z < min(R, Ry, W, depth), "zone must lie inside both bodies"
+    sag = ellipse_sag(R, Ry, z)  # defined for |z| < R only
+    assert sag < z, "zone must lie inside both bodies"
     # quads: blossom may leave a few triangles, so mesh at 2h and subdivide every cell (all quads,
     # the structured zone stays structured): zone curves get n/2 cells before subdivision
     hq = 2 * h if quads else h
