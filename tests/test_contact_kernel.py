@@ -120,6 +120,12 @@ def test_residual_is_weighted_traction():
     b = b.reshape(-1, 2)
     fi, fj = b[: NNODES // 2].sum(0), b[NNODES // 2 :].sum(0)
     np.testing.assert_allclose(fi, -fj, atol=1e-12)
+    theta = np.random.default_rng(5).uniform(0, 2 * np.pi, len(q))  # make_quadrature's normals
+    n = np.c_[np.cos(theta), np.sin(theta)]
+    t = np.c_[-n[:, 1], n[:, 0]]
+    w = q.weights[:, None]
+    traction = np.sum(w * (s["tau_n"][:, None] * n + s["tau_t"][:, None] * t), axis=0)
+    np.testing.assert_allclose(fj, traction, rtol=1e-12, atol=1e-12 * np.abs(traction).max())
     assert np.abs(fj).max() > 0
 
 
