@@ -52,17 +52,32 @@ def test_penetration_and_band():
     assert len(w) == 2 and "penetration" in w[0] and "within 10 % of the band" in w[1]
 
 
-def test_demo_reports_soft_penalty(tmp_path):
-    out = tmp_path / "soft"
+def hertz(out, *args):
     r = subprocess.run(
-        [sys.executable, str(ROOT / "demos" / "hertz.py"), "--h", "0.1", "--eps0", "100"]
+        [sys.executable, str(ROOT / "demos" / "hertz.py"), "--h", "0.1", *args]
         + ["--out", str(out)],
         capture_output=True,
         text=True,
         cwd=ROOT,
     )
     assert r.returncode == 0, r.stderr
-    warnings = json.loads((out / "metrics.json").read_text())["solver"]["warnings"]
+    return json.loads((out / "metrics.json").read_text()), r
+
+
+def test_demo_reports_stiff_penalty(tmp_path):
+    """eps0 = 1e-2 at h = a/10: p(x) 69 % off, an open/closed checkerboard, flagged; the
+    augmented enforcement at the same eps0 is not."""
+    m, _ = hertz(tmp_path / "stiff", "--eps0", "1e-2")
+    assert m["results"]["pressure_rel_l2_error"] > 0.3
+    assert any("checkerboard" in w for w in m["solver"]["warnings"])
+    m, _ = hertz(tmp_path / "al", "--eps0", "1e-2", "--enforcement", "augmented")
+    assert m["solver"]["warnings"] == []
+
+
+def test_demo_reports_soft_penalty(tmp_path):
+    out = tmp_path / "soft"
+    m, r = hertz(out, "--eps0", "100")
+    warnings = m["solver"]["warnings"]
     assert any("penetration" in w for w in warnings)
     assert any("band" in w for w in warnings)
     assert sum(line.startswith("WARNING: ") for line in r.stdout.splitlines()) == len(warnings)
