@@ -87,9 +87,10 @@ def problem(run):
 
 
 def stages(run):
-    """Press the top down until the reaction is P (frictionless, so path independent: the
-    secant may step back); then friction on and the top moved sideways until Q = r mu P,
-    approached from below (monotonic loading, as Cattaneo-Mindlin assumes)."""
+    """Press the top down until the reaction is P (frictionless; the approach is solved for in
+    Newton with the equation "reaction = P"); then friction on and the top moved sideways
+    while the tangential reaction rises to Q = r mu P (monotonic loading, as Cattaneo-Mindlin
+    assumes)."""
     p, pb, top = run.params, run.problem, run.loads
     a, P, r = estimate(p)[1], p["load"], p["tangential"]
     approach = -(a**2) / p["R"]  # the first guess: the Hertz approach a^2 / R

@@ -28,11 +28,14 @@ class NewtonOptions:
     max_cutbacks: int = 6
     fd_tangent: bool = False  # verification only: central differences of the contact residual
     fd_step: float = 1e-9
-    # augmented Lagrangian (Uzawa): stop when no multiplier changes by more than al_rtol of
-    # the largest traction; a step that needs more than max_augmentations solves fails
     line_search: bool = True  # halve a Newton step that does not lower the residual
     max_backtracks: int = 5
+    # augmented Lagrangian (Uzawa): stop when no multiplier changes by more than al_rtol of
+    # the largest traction *and* no gap by more than al_gtol h (the change of a multiplier is
+    # the gap over eps: a soft eps converges slowly, with small changes far from the answer);
+    # a step that needs more than max_augmentations solves fails
     al_rtol: float = 1e-9
+    al_gtol: float = 1e-8
     max_augmentations: int = 300
 
 
@@ -101,6 +104,8 @@ def newton(problem, lam, r_ref=0.0):
             if backtracks < opts.max_backtracks and it < opts.max_iterations:
                 backtracks += 1
                 problem.u.x.array[:] -= 0.5**backtracks * problem.du.x.array
+                if problem.control is not None:
+                    problem.control.backtrack(0.5**backtracks)
                 continue
         cycling = any(sig) and sig in seen and r >= 0.999 * seen[sig]
         if cycling:
@@ -126,6 +131,8 @@ def newton(problem, lam, r_ref=0.0):
                 problem.factorisations += not reuse
                 problem.ksp.setOperators(problem.J)
                 problem.ksp.solve(problem.R, problem.du.vector)
+                if problem.control is not None:  # force control: the bordered step
+                    problem.control.border(problem.ksp, problem.du.vector, lam)
             except PETSc.Error as e:
                 return False, residuals, f"linear solver error {e.ierr} at iteration {it}"
             reason = problem.ksp.getConvergedReason()
@@ -149,9 +156,12 @@ def augmented_loop(problem, lam, residuals, depth=20):
     the fixed point lambda = T(lambda), T(lambda) = the tractions of the solution with
     multipliers lambda (Uzawa's update, seed 003), accelerated by Anderson mixing of the last
     `depth` iterates (Walker & Ni 2011; restarted when the update grows). Stops when no
-    multiplier changes by more than al_rtol of the largest traction. Appends the inner Newton
-    residuals to `residuals`. Returns (ok, augmentations, why)."""
+    multiplier changes by more than al_rtol of the largest traction and no gap by more than
+    al_gtol h. Appends the inner Newton residuals to `residuals`.
+    Returns (ok, augmentations, why)."""
     cs, comm, opts = problem.contact, problem.comm, problem.newton
+    # lambda - tau = gap / eps at an active law point: the gap tolerance in traction units
+    gap_tol = opts.al_gtol * problem.scene.h_contact / max(cs.eps_n, cs.eps_t)
     X, F = [], []
     x = cs.multipliers()
     u_good = problem.u.x.array.copy()  # the last converged solve and its tractions
@@ -162,7 +172,7 @@ def augmented_loop(problem, lam, residuals, depth=20):
         f = t - x
         change = comm.allreduce(float(np.abs(f).max()) if f.size else 0.0, MPI.MAX)
         scale = comm.allreduce(float(np.abs(t).max()) if f.size else 0.0, MPI.MAX)
-        if change <= opts.al_rtol * scale:
+        if change <= min(opts.al_rtol * scale, gap_tol):
             return True, k, ""
         if k == opts.max_augmentations:
             break
@@ -214,6 +224,8 @@ def load_steps(problem, num_steps=1, lam_end=1.0, label="step", initial_guess=No
     cuts = 0
     while problem.lam < lam_end - 1e-14 * max(1.0, abs(lam_end)):
         target = min(problem.lam + dlam, lam_end)
+        if problem.control is not None:
+            problem.control.predict(target)
         if initial_guess is not None:
             initial_guess(problem, target)
         t0 = time.perf_counter()

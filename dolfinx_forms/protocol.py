@@ -58,6 +58,7 @@ class StageRecord:
     force: list | None = None
     target: float | None = None
     secant_iterations: int | None = None
+    method: str | None = None  # force control: "newton" (value solved for) or "secant"
 
     def as_dict(self):
         return asdict(self)
@@ -184,10 +185,19 @@ def reach_force(
     steps=1,
     label="force",
     name=None,
+    method="newton",
 ):
-    """Force control: secant iterations on the value of the Dirichlet condition `bc` until the
-    reaction component `component` at `boundary` is within tol |target| of `target` (name:
-    the condition's name in progress lines and the record, default `describe`).
+    """Force control: the value of the Dirichlet condition `bc` that makes the reaction
+    component `component` at `boundary` equal to `target` (name: the condition's name in
+    progress lines and the record, default `describe`).
+
+    method="newton" (a constant condition): the value is an unknown of Newton and the reaction
+    an equation (`force_control`); the reaction is ramped from its current value to the target
+    in `steps` load steps (monotonic loading whatever `monotone`), each one Newton solve, and
+    reached to Newton's tolerance; `first_guess` starts the first step.
+
+    method="secant" (or a condition with a value per dof): secant iterations until the
+    reaction is within tol |target| of the target.
 
     Each iterate is a stage from the last one (the first in `steps` load steps, the others in
     one), starting from the current value and reaction; `first_guess` is the first value of
@@ -197,10 +207,16 @@ def reach_force(
     reaction concave in the displacement (slip softens it), and a step that would reverse
     the direction of loading raises. Raises ContactSolverError when the force is not reached
     in `max_iter` stages."""
+    if method not in ("newton", "secant"):
+        raise ValueError(f"method: 'newton' or 'secant', not {method!r}")
     target = float(target)
+    name = describe(bc) if name is None else name
+    if method == "newton" and np.ndim(current_value(problem, bc)) == 0:
+        return _reach_in_newton(
+            problem, bc, boundary, component, target, first_guess, tol, steps, label, name
+        )
     history = [(current_value(problem, bc), float(problem.reaction(boundary)[component]))]
     value = float(first_guess)
-    name = describe(bc) if name is None else name
     nsteps = its = 0
     for k in range(int(max_iter)):
         n, i = _move(problem, [(bc, value)], steps if k == 0 else 1, f"{label} {name}={value:.6g}")
@@ -211,7 +227,7 @@ def reach_force(
         if abs(f1 - target) <= tol * abs(target):
             rec = StageRecord("force", label, nsteps, its, values={name: float(v1)})
             rec.boundary, rec.force = boundary, [float(f) for f in force]
-            rec.target, rec.secant_iterations = target, k + 1
+            rec.target, rec.secant_iterations, rec.method = target, k + 1, "secant"
             problem.log(
                 f"{label}: reaction {'xyz'[component]} on {boundary} = {f1:.6g} "
                 f"(target {target:.6g}) at {name} = {v1:.6g} after {k + 1} secant steps "
@@ -236,6 +252,49 @@ def reach_force(
         f"{label}: reaction {'xyz'[component]} on {boundary} = {f1:.6g} did "
         f"not reach {target:.6g} (tol {tol:g}) in {max_iter} secant steps"
     )
+
+
+def _reach_in_newton(
+    problem, bc, boundary, component, target, first_guess, tol, steps, label, name
+):
+    """reach_force's method="newton": the condition's value solved for with the reaction."""
+    from .force_control import ForceControl
+
+    for load in _loads(problem):  # every load held at its current value
+        v = current_value(problem, load)
+        setattr(load, _attr(load), Path(v, v))
+    index = next(i for i, d in enumerate(problem.dirichlet) if d is bc)
+    control = ForceControl(problem, index, boundary, component, target, first_guess)
+    bc.value, problem.control = control, None
+    n0 = len(problem.steps)
+    problem.lam, problem.control = 0.0, control
+    try:
+        problem.solve(int(steps), label=f"{label} {name}")
+    finally:
+        problem.control = None
+        bc.value = Path(control.s, control.s)
+    nsteps = len(problem.steps) - n0
+    its = sum(s.iterations for s in problem.steps[n0:])
+    force = problem.reaction(boundary)
+    f1 = float(force[component])
+    if not abs(f1 - target) <= tol * abs(target):  # Newton's tolerance is far tighter
+        raise ContactSolverError(
+            f"{label}: reaction {'xyz'[component]} on {boundary} = {f1:.6g} is not the target "
+            f"{target:.6g} (tol {tol:g}) after Newton converged"
+        )
+    rec = StageRecord("force", label, nsteps, its, values={name: float(control.s)})
+    rec.boundary, rec.force, rec.target, rec.method = (
+        boundary,
+        [float(f) for f in force],
+        target,
+        "newton",
+    )
+    problem.log(
+        f"{label}: reaction {'xyz'[component]} on {boundary} = {f1:.6g} (target {target:.6g}) "
+        f"at {name} = {control.s:.6g}, solved for in Newton ({nsteps} load steps, {its} Newton "
+        "iterations)"
+    )
+    return rec
 
 
 def friction_on(problem, mu, label="friction"):

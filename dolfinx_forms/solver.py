@@ -199,6 +199,7 @@ class ContactProblem:
         self.ksp.setFromOptions()
         self.factor_key = None  # what the last factorisation was of (newton.py reuses it)
         self.factorisations = 0
+        self.control = None  # force_control.ForceControl while a force-controlled stage runs
         self.u_committed = self.u.x.array.copy()
         self.lam = 0.0
         self.steps = []
@@ -255,12 +256,22 @@ class ContactProblem:
             self.force_scale = max(self.Ku.norm(), self.f.norm())
             if with_tangent:
                 self.J.assemble()
+                if self.control is not None:
+                    self.control.linearise(self.J)
                 self.J.zeroRows(self.bc_global, diag=1.0)
-            if zero_bc:
-                self.R.array[self.bc_owned] = 0.0
+            if self.control is None:
+                return self._zero_bc(zero_bc)
+            self.control.measure(self.R)  # the reaction, from the rows zeroed next
+            return float(np.hypot(self._zero_bc(zero_bc), self.control.residual(lam)))
+
+    def _zero_bc(self, zero_bc):
+        if zero_bc:
+            self.R.array[self.bc_owned] = 0.0
         return self.R.norm()
 
     def commit(self, lam):
+        if self.control is not None:
+            self.control.commit(lam)
         self.contact.commit()
         self.u_committed[:] = self.u.x.array
         self.lam = lam
@@ -269,6 +280,8 @@ class ContactProblem:
         self.u.x.array[:] = self.u_committed
         self.u.x.scatter_forward()
         self.contact.restore()
+        if self.control is not None:
+            self.control.restore()
 
     def solve(self, num_steps=1, lam_end=1.0, label="step", initial_guess=None):
         """Ramp the load from the committed level to lam_end in num_steps equal steps, with

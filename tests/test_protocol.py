@@ -92,19 +92,35 @@ def test_ramp_moves_tractions_and_holds_them(scene):
     )
 
 
-@pytest.mark.parametrize("monotone", [False, True])
-def test_reach_force(scene, monotone):
+@pytest.mark.parametrize(
+    "method,monotone", [("secant", False), ("secant", True), ("newton", False)]
+)
+def test_reach_force(scene, method, monotone):
     problem, top = patch_problem(scene)
     target, tol = -0.004, 1e-6
     # monotone: approach from below (a first guess short of the answer -0.00497)
     rec = protocol.reach_force(
-        problem, top, "upper_top", 1, target, first_guess=-0.002, tol=tol, monotone=monotone
+        problem,
+        top,
+        "upper_top",
+        1,
+        target,
+        first_guess=-0.002,
+        tol=tol,
+        monotone=monotone,
+        method=method,
     )
     force = problem.reaction("upper_top")[1]
-    assert abs(force - target) <= tol * abs(target)
     assert rec.force[1] == pytest.approx(force, rel=1e-12)
     assert rec.kind == "force" and rec.target == target and rec.boundary == "upper_top"
-    assert rec.secant_iterations <= 3  # linear: the secant is exact after the first step
+    assert rec.method == method
+    if method == "secant":
+        assert abs(force - target) <= tol * abs(target)
+        assert rec.secant_iterations <= 3  # linear: the secant is exact after the first step
+    else:  # solved with the displacement: the target to Newton's tolerance, in one solve
+        assert force == pytest.approx(target, rel=1e-9)
+        assert rec.secant_iterations is None and rec.load_steps == 1
+        assert rec.newton_iterations <= 4  # one to close the gap, then the linear answer
     d = protocol.current_value(problem, top)
     assert force == pytest.approx(penalised_reaction(problem, -d), rel=1e-9)
 
@@ -112,11 +128,20 @@ def test_reach_force(scene, monotone):
 def test_reach_force_failures(scene):
     problem, top = patch_problem(scene)
     with pytest.raises(ContactSolverError, match="did not reach"):
-        protocol.reach_force(problem, top, "upper_top", 1, -0.004, first_guess=-0.001, max_iter=1)
+        protocol.reach_force(
+            problem, top, "upper_top", 1, -0.004, first_guess=-0.001, max_iter=1, method="secant"
+        )
     # monotone loading refuses to go back
     with pytest.raises(ContactSolverError, match="reverse"):
         protocol.reach_force(
-            problem, top, "upper_top", 1, -0.0005, first_guess=-0.002, monotone=True
+            problem,
+            top,
+            "upper_top",
+            1,
+            -0.0005,
+            first_guess=-0.002,
+            monotone=True,
+            method="secant",
         )
 
 
