@@ -44,6 +44,11 @@ OPTIONS = [  # option, kind, default[, help]
      "largest initial gap covered by the contact surface (default: the gap at x = 1.6 a)"),
     ("--width", "(0, inf)", None, "block width (default max(40, 40 a))"),
     ("--depth", "(0, inf)", None, "block depth (default max(20, 20 a))"),
+    ("--zone", "(0, inf)", 1.2, "half-width of the zone meshed at h, in units of the Hertz a"),
+    ("--h-far", "(0, inf)", None, "mesh size far from the contact (default min(R, depth) / 2)"),
+    ("--grading", "(0, inf)", None,
+     "size growth away from the zone: slope (body-fitted, default 0.5) or ratio of "
+     "neighbouring cells (cut, > 1, default 2)"),
     ("--eps0", "(0, inf)", 0.5, "penalty factor of eq 51: eps = eps0 h / E"),
     ("--degree", [1, 2], 1),
     ("--grid-refine", range(1, 17), 4, "level-set grid cells per contact mesh size h"),
@@ -60,6 +65,8 @@ def parse(argv):
     a = p.parse_args(argv)
     if a.tangential > 0 and a.mu == 0:
         p.error("--tangential: a Cattaneo-Mindlin stage needs --mu > 0")
+    if a.grading is not None and a.discretization == "cut" and not a.grading > 1:
+        p.error(f"--grading: the cut grid's growth ratio must be > 1, got {a.grading:g}")
     return a
 
 
@@ -70,17 +77,20 @@ def estimate(p):
 
 
 def scene(run):
-    """The block and the half-cylinder, mesh size h on the zone |x| < 1.6 a."""
-    p = run.params
-    size = dict(R=p["R"], width=p["width"], depth=p["depth"], h=p["h"], zone=1.6 * estimate(p)[1])
-    if p["discretization"] == "cut":  # graded grid, spacing h on the zone; cylinder cut
+    """The block and the half-cylinder, mesh size h on the zone |x|, |y| < zone a."""
+    p, cut = run.params, run.params["discretization"] == "cut"
+    size = dict(R=p["R"], width=p["width"], depth=p["depth"], h=p["h"], zone=p["zone"])
+    size["zone"] *= estimate(p)[1]
+    size["h_far"] = p["h_far"] or min(p["R"], p["depth"]) / 2
+    size["growth"] = p["grading"] or (2.0 if cut else 0.5)
+    if cut:  # graded grid, spacing h on the zone; cylinder cut
         return hertz_cut_scene(run.comm, **size)
     return hertz_scene(run.comm, **size, quads=p["quads"])
 
 
 def problem(run):
     """Block clamped at its bottom; the cylinder top held (moved by the stages); frictionless."""
-    p, zone = run.params, 1.6 * estimate(run.params)[1]
+    p, zone = run.params, 1.6 * estimate(run.params)[1]  # the band covers |x| < 1.6 a
     run.loads = dict(x=Dirichlet("cylinder_top", 0, 0.0), y=Dirichlet("cylinder_top", 1, 0.0))
     bcs = [Dirichlet("block_bottom", None, 0.0), run.loads["x"], run.loads["y"]]
     return run.contact_problem(bcs, mu=0.0, band=p["band"] or zone ** 2 / (2 * p["R"]))

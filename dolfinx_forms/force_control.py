@@ -61,9 +61,10 @@ class ForceControl:
         """k = J^T 1_b from the full tangent (before its Dirichlet rows are zeroed)."""
         J.multTranspose(self.sel, self.k)
 
-    def border(self, ksp, du, lam):
-        """Turn the step du = -J^-1 R into the bordered step (one more solve, same factors)."""
-        ksp.solve(self.g, self.w)
+    def border(self, solve, du, lam):
+        """Turn the step du = -J^-1 R into the bordered step: solve(b, x) solves with J (one
+        more solve with the same factors)."""
+        solve(self.g, self.w)
         dF1, dF2 = self.k.dot(du), self.k.dot(self.w)
         scale = self.k.norm() * self.w.norm()
         if abs(dF2) <= 1e-12 * scale:  # nothing couples s to F yet: keep s this iteration

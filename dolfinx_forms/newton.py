@@ -113,7 +113,7 @@ def newton(problem, lam, r_ref=0.0):
         seen[sig] = min(r, seen.get(sig, np.inf))
         if it == opts.max_iterations:
             break
-        # The factorisation is reused when J is the same matrix: a linear bulk, the same active
+        # J is the same matrix (its factorisation reused) for a linear bulk, the same active
         # set, mu and a constant contact tangent (frictionless or no slipping point), no predictor
         key = None
         if not problem.bulk.nonlinear and not predictor:
@@ -124,24 +124,15 @@ def newton(problem, lam, r_ref=0.0):
         r_base, sig_base, backtracks = r, sig, 0
         with problem.phase("solve"):
             problem.R.scale(-1.0)
-            try:
-                reuse = key is not None and key == problem.factor_key
-                problem.ksp.getPC().setReusePreconditioner(reuse)
-                problem.factor_key = key
-                problem.factorisations += not reuse
-                problem.ksp.setOperators(problem.J)
-                problem.ksp.solve(problem.R, problem.du.vector)
+            try:  # linear.py: a full factorisation, or the condensed bulk
+                problem.linear.setup(problem.J, key)
+                problem.linear.solve(problem.R, problem.du.vector)
                 if problem.control is not None:  # force control: the bordered step
-                    problem.control.border(problem.ksp, problem.du.vector, lam)
+                    problem.control.border(problem.linear.solve, problem.du.vector, lam)
             except PETSc.Error as e:
                 return False, residuals, f"linear solver error {e.ierr} at iteration {it}"
-            reason = problem.ksp.getConvergedReason()
-            if reason < 0:
-                return (
-                    False,
-                    residuals,
-                    f"linear solver diverged (reason {reason}) at iteration {it}",
-                )
+            except RuntimeError as e:  # LinearSolverError, or PETSc's through the C++ glue
+                return False, residuals, f"{e} at iteration {it}"
         problem.du.x.scatter_forward()
         problem.u.x.array[:] += problem.du.x.array
     return False, residuals, f"no convergence in {opts.max_iterations} iterations"

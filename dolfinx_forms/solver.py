@@ -22,6 +22,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from .boundary import BodyForce, Dirichlet, Load, Traction, dirichlet_dofs  # noqa: F401
+from . import linear
 from .bulk import BulkForms
 from .contact_set import STATE_NAMES, ContactSet  # noqa: F401
 from .laws import as_law
@@ -53,6 +54,8 @@ class ContactProblem:
     default "P1" with "augmented", None with "penalty". multiplier_length: default h body-fitted,
     1.5 h cut (Hertz at h = a/20, P1: 0.5 h and, on the cut path, 0.75 h give a checkerboard;
     p(x) 1.9 / 2.3 / 3.1 % body-fitted at 0.75 / 1 / 1.5 h, 3.9 / 3.4 % cut at 1 / 1.5 h).
+    linear_solver: "auto", "condensed" or "factorised" (`linear.py`: a linear bulk on one
+    process is factorised once, with Newton on the Schur complement of the contact dofs).
     """
 
     def __init__(
@@ -83,6 +86,7 @@ class ContactProblem:
         enforcement="penalty",
         multipliers="default",
         multiplier_length=None,
+        linear_solver="auto",
         log=print,
     ):
         self.scene, self.mesh = scene, scene.mesh
@@ -190,21 +194,19 @@ class ContactProblem:
             self.Ku = self.K.createVecLeft()
             self.f = self.K.createVecLeft()
 
-        self.ksp = PETSc.KSP().create(self.comm)
-        self.ksp.setOptionsPrefix("ils_")
-        opts = PETSc.Options()
-        defaults = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
-        for k, v in {**defaults, **(petsc_options or {})}.items():
-            opts["ils_" + k] = v
-        self.ksp.setFromOptions()
-        self.factor_key = None  # what the last factorisation was of (newton.py reuses it)
-        self.factorisations = 0
+        with self.phase("solve"):  # the condensed bulk is factorised here, once
+            self.linear = linear.choose(self, linear_solver, petsc_options)
         self.control = None  # force_control.ForceControl while a force-controlled stage runs
         self.u_committed = self.u.x.array.copy()
         self.lam = 0.0
         self.steps = []
 
     # ------------------------------------------------------------------ utilities
+    @property
+    def factorisations(self):
+        """Sparse factorisations so far (the condensed bulk: one per scene)."""
+        return self.linear.factorisations
+
     @property
     def mu(self):
         return self.contact.mu
@@ -326,6 +328,9 @@ def solver_metrics(problem, converged=True):
         "augmentations": [int(s.augmentations) for s in problem.steps],
         "cutbacks": int(sum(s.cutback for s in problem.steps)),
         "factorisations": int(problem.factorisations),
+        "linear_solver": problem.linear.name,
+        "schur_factorisations": int(getattr(problem.linear, "schur_factorisations", 0)),
+        "condensed_dofs": int(getattr(problem.linear, "num_dofs", 0)),
     }
 
 

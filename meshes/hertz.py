@@ -57,7 +57,7 @@ def _arc_length(R, Ry, x):
     return 0.5 * t1 * float(np.sum(w * np.hypot(R * np.cos(t), Ry * np.sin(t))))
 
 
-def _build(gmsh, R, W, depth, z, h, h_far, quads, Ry=None):
+def _build(gmsh, R, W, depth, z, h, h_far, quads, Ry=None, growth=GROWTH):
     """Rank 0: both bodies, each split into a zone part (|x|, |y| <= z) and the rest (shared
     curves inside a body only), then meshed. quads: the zone parts are structured (transfinite)
     grids with edges <= h, the rest is recombined. Triangles: unstructured everywhere.
@@ -132,7 +132,7 @@ def _build(gmsh, R, W, depth, z, h, h_far, quads, Ry=None):
         if attempt:
             gmsh.model.mesh.clear()
         gmsh.model.mesh.field.setNumber(f, "VIn", fac * hq)
-        gmsh.model.mesh.field.setNumber(f, "Thickness", (h_far - fac * h) * hq / h / GROWTH)
+        gmsh.model.mesh.field.setNumber(f, "Thickness", (h_far - fac * h) * hq / h / growth)
         gmsh.model.mesh.generate(2)
         _, x, cells = extract_gmsh(gmsh)
         ratio = max_edge_in_box(x, cells, [[-z, -z], [z, z]]) / h
@@ -162,6 +162,7 @@ def hertz_scene(
     quads=False,
     contact_box=None,
     Ry=None,
+    growth=GROWTH,
 ) -> Scene:
     """The Hertz scene (see the module docstring): a half-ellipse of semi-axes R (horizontal)
     and Ry (vertical, default R: the half-cylinder) on the block; contact_box overrides
@@ -200,7 +201,7 @@ def hertz_scene(
     }
     with gmsh_model(comm, "hertz") as gmsh:
         if comm.rank == 0:
-            _build(gmsh, R, W, depth, zone, h, h_far, quads, Ry)
+            _build(gmsh, R, W, depth, zone, h, h_far, quads, Ry, growth)
         box = hertz_contact_box(R, width, depth, zone, Ry) if contact_box is None else contact_box
         return scene_from_gmsh(comm, bodies, markers, [(0, 1)], h, contact_box=box)
 

@@ -12,6 +12,7 @@ void bind_cut(py::module_& m);
 void bind_mls(py::module_& m);
 void bind_evolution(py::module_& m);
 void bind_broad_phase(py::module_& m);
+void bind_schur(py::module_& m);
 
 PYBIND11_MODULE(_cpp, m) {
   m.doc() = "ILS contact core: level sets, closest points, contact surface, return mapping";
@@ -23,4 +24,5 @@ PYBIND11_MODULE(_cpp, m) {
   bind_mls(m);
   bind_evolution(m);
   bind_broad_phase(m);
+  bind_schur(m);
 }

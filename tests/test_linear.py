@@ -1,0 +1,77 @@
+"""Newton's linear solves (dolfinx_forms.linear): the condensed bulk (one sparse factorisation,
+Newton on the dense Schur complement of the contact dofs) against a full factorisation per
+iteration, on the same frictional Hertz path (normal force, then a tangential one), both paths.
+
+Both solve J du = -R exactly (direct solvers): the iterates, hence the converged states, agree
+to round-off amplified by the conditioning, far below the Newton tolerance (1e-10 of R)."""
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from dolfinx_forms import linear, protocol
+from dolfinx_forms.laws import NeoHookean
+from dolfinx_forms.solver import ContactProblem, Dirichlet
+
+E, NU, R, P = 1.0e4, 0.3, 10.0, 430.0
+pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial: MUMPS Schur")
+
+
+def scene(kind):
+    from meshes.cut import hertz_cut_scene
+    from meshes.hertz import hertz_scene
+
+    size = dict(R=R, width=20.0, depth=10.0, h=0.25, zone=1.6)
+    if kind == "cut":
+        return hertz_cut_scene(MPI.COMM_WORLD, **size)
+    return hertz_scene(MPI.COMM_WORLD, **size)
+
+
+def mindlin(sc, linear_solver, materials=None):
+    top_x, top_y = Dirichlet("cylinder_top", 0, 0.0), Dirichlet("cylinder_top", 1, 0.0)
+    pb = ContactProblem(
+        sc,
+        materials or {b.tag: (E, NU) for b in sc.bodies},
+        eps0=0.5,
+        band=1.6**2 / (2 * R),
+        dirichlet=[Dirichlet("block_bottom", None, 0.0), top_x, top_y],
+        linear_solver=linear_solver,
+        log=lambda *a, **k: None,
+    )
+    protocol.reach_force(pb, top_y, "block_bottom", 1, P, first_guess=-0.1)
+    protocol.friction_on(pb, 0.3)
+    protocol.reach_force(pb, top_x, "cylinder_top", 0, 0.5 * 0.3 * P, 1e-5, monotone=True)
+    return pb
+
+
+@pytest.mark.parametrize("kind", ["conforming", "cut"])
+def test_condensed_equals_factorised(kind):
+    sc = scene(kind)
+    a, b = mindlin(sc, "condensed"), mindlin(sc, "factorised")
+    assert a.linear.name == "condensed" and b.linear.name == "factorised"
+    assert 0 < a.linear.num_dofs < a.num_dofs // 4
+    ua, ub = a.u.x.array, b.u.x.array
+    assert np.abs(ua - ub).max() <= 1e-9 * np.abs(ub).max()
+    assert [s.iterations for s in a.steps] == [s.iterations for s in b.steps]
+    # one sparse factorisation for the whole path, one dense Schur update per changed J
+    assert a.factorisations == 1 and b.factorisations > 1
+    assert a.linear.schur_factorisations == b.factorisations
+    assert a.reaction("cylinder_top")[0] == pytest.approx(0.5 * 0.3 * P, rel=1e-9)
+
+
+def test_choice():
+    sc = scene("cut")
+    pb = mindlin(sc, "auto")
+    assert pb.linear.name == "condensed"
+    with pytest.raises(ValueError, match="linear_solver: 'auto', 'condensed' or 'factorised'"):
+        linear.choose(pb, "schur")
+    # the user's solver options are honoured: a full factorisation
+    assert linear.choose(pb, "auto", {"pc_factor_mat_solver_type": "superlu"}).name == "factorised"
+    assert linear.choose(pb, "auto", dict(linear.DEFAULT_OPTIONS)).name == "condensed"
+
+
+def test_nonlinear_bulk_is_factorised():
+    sc = scene("conforming")
+    laws = {b.tag: NeoHookean(E, NU) for b in sc.bodies}
+    with pytest.raises(ValueError, match="nonlinear"):
+        mindlin(sc, "condensed", laws)
