@@ -112,6 +112,23 @@ def bounded(name, lo=None, hi=None, lo_open=False, hi_open=False):
     return convert
 
 
+def integer(name, values):
+    """Int type for argparse accepting the integers of the range `values`; the message names
+    the range (argparse's own `choices` message would list every accepted value)."""
+    span = f"[{values[0]}..{values[-1]}]"
+
+    def convert(text):
+        try:
+            k = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be an integer in {span}, got {text!r}")
+        if k not in values:
+            raise argparse.ArgumentTypeError(f"{name} must be in {span}, got {text}")
+        return k
+
+    return convert
+
+
 def interval(option, text):
     """A `bounded` float type from an interval: "(0, inf)", "[0, 1)", "(-1, 0.5)"."""
     m = re.fullmatch(r"([\[(])\s*([^,\s]+)\s*,\s*([^\s\])]+)\s*([\])])", text)
@@ -134,7 +151,7 @@ def add_options(parser, rows):
         if isinstance(kind, str):
             kw["type"] = interval(option, kind)
         elif isinstance(kind, range):
-            kw.update(type=int, choices=kind, metavar=f"[{kind[0]}..{kind[-1]}]")
+            kw.update(type=integer(option, kind), metavar=f"[{kind[0]}..{kind[-1]}]")
         elif isinstance(kind, list):
             kw.update(type=type(kind[0]), choices=kind)
         elif kind is bool:
@@ -179,6 +196,22 @@ def petsc_options(parser, items):
                 f"--petsc: PETSc refuses {k}={opts[k]} (error {ierr}: an unknown type "
                 "or a value of the wrong kind)"
             )
+    if opts:
+        ierr, unread = petsc_trial(opts)
+        every = {**SOLVER_DEFAULTS, **opts}
+        given = ", ".join(f"{k}={v}" for k, v in opts.items())
+        if ierr is not None:
+            parser.error(
+                f"--petsc: a trial solve with {given} fails (PETSc error {ierr}: "
+                "an option of the wrong kind for this solver)"
+            )
+        if unread:
+            k = unread[0]
+            parser.error(
+                f"--petsc: the linear solver does not read {k}={opts[k]} (an unknown or "
+                f"misspelled key, or one without effect with ksp_type={every['ksp_type']}, "
+                f"pc_type={every['pc_type']})"
+            )
     return opts
 
 
@@ -203,6 +236,114 @@ def petsc_refuses(opts):
         for k in opts:
             o.delValue(prefix + k)
         ksp.destroy()
+
+
+# the linear solver's own options (dolfinx_forms/linear.py DEFAULT_OPTIONS), which --petsc
+# overrides: the trial solve reads the user's options on top of them, as the solver does
+SOLVER_DEFAULTS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+
+
+def _petsc_used():
+    """PetscOptionsUsed(NULL, name, &flag) of the loaded PETSc library as a function of the
+    option name (no leading dash), or None where it cannot be found (then nothing is
+    refused as unread)."""
+    import ctypes
+
+    try:
+        with open("/proc/self/maps") as f:
+            path = next(ln.split()[-1] for ln in f if "/libpetsc" in ln and ".so" in ln)
+        fn = ctypes.CDLL(path).PetscOptionsUsed
+    except (OSError, StopIteration, AttributeError):
+        return None
+    fn.argtypes = [ctypes.c_void_p, ctypes.c_char_p, ctypes.POINTER(ctypes.c_int)]
+    fn.restype = ctypes.c_int
+
+    def used(name):
+        flag = ctypes.c_int(0)
+        return fn(None, name.encode(), ctypes.byref(flag)) == 0 and flag.value != 0
+
+    return used
+
+
+def _trial_matrix(PETSc, n=12):
+    """A small SPD system with the solver's block size 2: two decoupled 5-point Laplacians
+    on an n x n grid (large enough for a multigrid to build levels)."""
+    import numpy as np
+
+    rows, cols = [], []
+    for i in range(n):
+        for j in range(n):
+            for ii, jj in ((i, j), (i - 1, j), (i + 1, j), (i, j - 1), (i, j + 1)):
+                if 0 <= ii < n and 0 <= jj < n:
+                    rows.append(i * n + j)
+                    cols.append(ii * n + jj)
+    rows, cols = np.array(rows), np.array(cols)
+    vals = np.where(rows == cols, 4.0, -1.0)
+    r2 = np.concatenate([2 * rows, 2 * rows + 1])
+    c2 = np.concatenate([2 * cols, 2 * cols + 1])
+    v2 = np.concatenate([vals, vals * 1.5])
+    order = np.lexsort((c2, r2))
+    r2, c2, v2 = r2[order], c2[order], v2[order]
+    indptr = np.searchsorted(r2, np.arange(2 * n * n + 1)).astype(PETSc.IntType)
+    A = PETSc.Mat().createAIJ(
+        (2 * n * n, 2 * n * n),
+        bsize=2,
+        csr=(indptr, c2.astype(PETSc.IntType), v2),
+        comm=PETSc.COMM_SELF,
+    )
+    A.assemble()
+    return A
+
+
+def petsc_trial(opts):
+    """Solve a small system with the solver's defaults overridden by `opts` (scratch prefix,
+    COMM_SELF, removed after; anything PETSc prints, e.g. ksp_view, is discarded). Returns
+    (PETSc's error code or None, the keys of `opts` PETSc never read, in their order)."""
+    import ctypes
+    import os
+
+    from petsc4py import PETSc
+
+    o, prefix = PETSc.Options(), "ils_check_"
+    every = {**SOLVER_DEFAULTS, **opts}
+    for k, v in every.items():
+        o[prefix + k] = v
+    A = _trial_matrix(PETSc)
+    ksp = PETSc.KSP().create(PETSc.COMM_SELF)
+    ksp.setOptionsPrefix(prefix)
+    sys.stdout.flush()
+    saved = os.dup(1)
+    null = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(null, 1)
+    PETSc.Sys.pushErrorHandler("ignore")
+    ierr = None
+    try:
+        ksp.setOperators(A)
+        ksp.setFromOptions()
+        b = A.createVecLeft()
+        b.set(1.0)
+        x = b.duplicate()
+        ksp.solve(b, x)
+        for v in (b, x):
+            v.destroy()
+    except PETSc.Error as e:
+        ierr = e.ierr
+    finally:
+        PETSc.Sys.popErrorHandler()
+        try:
+            ctypes.CDLL(None).fflush(None)  # C stdio buffers still hold the discarded text
+        except (OSError, AttributeError):
+            pass
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(null)
+        used = _petsc_used() if ierr is None else None
+        unread = [k for k in opts if used is not None and not used(prefix + k)]
+        for k in every:
+            o.delValue(prefix + k)
+        ksp.destroy()
+        A.destroy()
+    return ierr, unread
 
 
 def demo_parser(prog, doc, out, options=(), discretization=True, petsc=True, cells=None):
