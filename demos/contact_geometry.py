@@ -42,7 +42,22 @@ def parse(argv=None):
         p.error(f"argument --h: must be <= width/4 = {args.width / 4}, got {args.h}")
     if args.width > args.R:
         p.error(f"argument --width: must be <= R = {args.R}, got {args.width}")
+    if args.h < args.width / 2000:
+        p.error(
+            f"argument --h: must be >= width/2000 = {args.width / 2000:g} (a grid of at most "
+            f"4000 x 2000 cells), got {args.h}"
+        )
+    if args.R > 1e9 * args.width:
+        p.error(
+            f"argument --R: must be <= 1e9 width = {1e9 * args.width:g} (a flatter cylinder is "
+            f"flat to round-off), got {args.R}"
+        )
     args.eps = 4 * args.h if args.eps is None else args.eps
+    if not args.gap < min(2 * args.eps, args.width):
+        p.error(
+            f"argument --gap: must be < min(2 eps, width) = {min(2 * args.eps, args.width):g} "
+            f"(the contact region of eq 22 is empty, or outside the grid), got {args.gap}"
+        )
     return args
 
 

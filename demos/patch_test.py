@@ -47,6 +47,8 @@ OPTIONS = [  # option, kind, default[, help]
 def parse(argv):
     p = cli.demo_parser("patch_test.py", __doc__, "results/patch_test", OPTIONS)
     a = p.parse_args(argv)
+    if a.h < 1e-3:
+        p.error(f"--h: must be >= 1/1000 (at most 1000 x 500 cells per block), got {a.h}")
     nx = round(1.0 / a.h)
     if abs(nx * a.h - 1.0) > 1e-12:
         p.error(

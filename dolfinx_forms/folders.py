@@ -15,8 +15,9 @@ the relative paths of every file and folder it wrote). Rules for `--out PATH`:
   earlier result of ours that are not written again are removed; files and folders the
   marker does not list are never deleted or overwritten (a name clash is an error and
   nothing is moved).
-* PATH a file, '' or '.', the current folder or one of its parents, the filesystem root or
-  the home folder: always refused.
+* PATH a file, '' or '.', the current folder or one of its parents, the filesystem root, the
+  home folder, or (running from a source tree) the repository root or a package's source
+  folder: always refused, also with ``--force``.
 
 Folders get the permissions 0o777 & ~umask (mkdtemp makes 0o700), files those of open().
 SIGINT/SIGTERM while the results are written remove the temporary folder (it never carries
@@ -115,6 +116,19 @@ def folder_state(out: Path) -> str:
     return "foreign"
 
 
+def _source_folders():
+    """{path: what} of the repository root and the packages' source folders when this code
+    runs from a source tree (pyproject.toml next to the package), else {}."""
+    package = Path(__file__).resolve().parent
+    root = package.parent
+    if not (root / "pyproject.toml").is_file():
+        return {}
+    out = {root: "the repository root"}
+    for name in ("dolfinx_forms", "meshes"):
+        out[root / name] = f"the source folder of the package {name}"
+    return out
+
+
 def _forbidden(text: str, path: Path):
     """Why `path` may never be a result folder, or None."""
     if text.strip() in ("", "."):
@@ -131,7 +145,7 @@ def _forbidden(text: str, path: Path):
         return "the current folder"
     if path in cwd.parents:
         return "a parent of the current folder"
-    return None
+    return _source_folders().get(path)
 
 
 def _not_ours(out: Path) -> str:
