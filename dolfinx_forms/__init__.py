@@ -6,6 +6,13 @@ the intermediate contact surface) and the contact constitutive update (gaps,
 return mapping). Equation numbers refer to Liu & Sun, ILS-MPM (seed paper 000).
 """
 
+import os
+
+# A process started without mpirun is an Open MPI singleton: by default its MPI_Init starts a
+# helper daemon (for MPI_Comm_spawn, which this code never calls), ~0.4 s of every run's start.
+# Under mpirun the setting has no effect; a user's own value is kept.
+os.environ.setdefault("OMPI_MCA_ess_singleton_isolated", "1")
+
 try:
     from . import _cpp
 except ImportError as e:  # pragma: no cover - a clear message instead of a bare ImportError

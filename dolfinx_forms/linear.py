@@ -23,7 +23,7 @@ from petsc4py import PETSc
 from . import _cpp
 
 DEFAULT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
-MAX_CONDENSED = 6000  # dense m x m LU per iteration: beyond this a sparse refactorisation wins
+MAX_CONDENSED = 3000  # dense m x m LU per iteration: near here a sparse refactorisation wins
 
 
 class LinearSolverError(RuntimeError):
