@@ -321,25 +321,27 @@ def _signals_blocked():
 
 
 @contextmanager
-def _sigterm_unwinds():
-    """SIGTERM raises SystemExit(143) while the results are written (if the handler is the
-    default one and this is the main thread), so the temporary folder is removed."""
+def _signals_unwind():
+    """While the results are written (main thread only), SIGINT raises KeyboardInterrupt and
+    SIGTERM SystemExit(143) where the handler is the default action, so the temporary folder is
+    removed: importing gmsh (also through dolfinx.io.gmshio) sets SIGINT's handler to the
+    default action, and only gmsh.finalize restores it. Other handlers are left alone."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    old = signal.getsignal(signal.SIGTERM)
-    if old is not signal.SIG_DFL:
-        yield
-        return
 
-    def handler(signum, frame):
+    def term(signum, frame):
         raise SystemExit(128 + signum)
 
-    signal.signal(signal.SIGTERM, handler)
+    handlers = {signal.SIGINT: signal.default_int_handler, signal.SIGTERM: term}
+    ours = [s for s in handlers if signal.getsignal(s) is signal.SIG_DFL]
+    for s in ours:
+        signal.signal(s, handlers[s])
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, old)
+        for s in ours:
+            signal.signal(s, signal.SIG_DFL)
 
 
 @contextmanager
@@ -357,29 +359,33 @@ def atomic_output_dir(out, comm=None, force=False, program=None):
 
     comm = MPI.COMM_WORLD if comm is None else comm
     program = program or program_name()
-    status = None
-    if comm.rank == 0:
-        try:
-            path = check_output_path(out, force)
-            path.parent.mkdir(parents=True, exist_ok=True)
-            tmp = tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".partial", dir=path.parent)
-            os.chmod(tmp, dir_mode())
-            status = ("ok", str(path), tmp)
-        except OSError as e:
-            status = ("error", f"--out: cannot write {out}: {e.strerror or e}")
-        except OutputFolderError as e:
-            status = ("error", str(e))
-    status = comm.bcast(status, root=0)
-    if status[0] != "ok":
-        raise OutputFolderError(status[1])
-    path, tmp = Path(status[1]), Path(status[2])
-    try:
-        with _sigterm_unwinds():
+    tmp = None
+    try:  # from the temporary folder's creation until every rank has written into it
+        with _signals_unwind():
+            status = None
+            if comm.rank == 0:
+                try:
+                    path = check_output_path(out, force)
+                    path.parent.mkdir(parents=True, exist_ok=True)
+                    tmp = tempfile.mkdtemp(
+                        prefix=f".{path.name}.", suffix=".partial", dir=path.parent
+                    )
+                    os.chmod(tmp, dir_mode())
+                    status = ("ok", str(path), tmp)
+                except OSError as e:
+                    status = ("error", f"--out: cannot write {out}: {e.strerror or e}")
+                except OutputFolderError as e:
+                    status = ("error", str(e))
+            status = comm.bcast(status, root=0)
+            if status[0] != "ok":
+                raise OutputFolderError(status[1])
+            path, tmp = Path(status[1]), Path(status[2])
             yield tmp
+            comm.barrier()  # every rank has finished writing
     except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
+        if tmp is not None:
+            shutil.rmtree(tmp, ignore_errors=True)
         raise
-    comm.barrier()  # every rank has finished writing
     result = None
     if comm.rank == 0:
         with _signals_blocked():
