@@ -11,7 +11,9 @@ JOBS    ?= 2
 APT_PACKAGES := cmake make gcc g++ python3-sympy python3-dolfinx libdolfinx-dev python3-gmsh gmsh \
 	libeigen3-dev python3-mpi4py python3-meshio pybind11-dev python3-pytest \
 	python3-scipy python3-matplotlib libgtest-dev libbenchmark-dev python3-setuptools \
-	python3-venv openmpi-bin libnanoflann-dev
+	python3-venv openmpi-bin libnanoflann-dev libopenblas0-pthread
+# only `make bench` installs these: benchmarks/work_precision.py compares with GetFEM's nodal P1
+BENCH_PACKAGES := python3-getfem
 export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1
@@ -20,10 +22,19 @@ export PYTHONPATH := $(CURDIR)$(if $(PYTHONPATH),:$(PYTHONPATH))
 MPIRUN  ?= mpirun -n 2
 SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: deps build test test-cpp test-python test-mpi demo bench format clean
+.PHONY: deps bench-deps build test test-cpp test-python test-mpi demo bench format clean
 
 deps:
 	@missing=$$(for p in $(APT_PACKAGES); do \
+	  dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+	  echo "Installing Debian packages:" $$missing; \
+	  $(SUDO) apt-get update -q && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -q --no-install-recommends $$missing; \
+	fi
+
+bench-deps:
+	@missing=$$(for p in $(BENCH_PACKAGES); do \
 	  dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; done); \
 	if [ -n "$$missing" ]; then \
 	  echo "Installing Debian packages:" $$missing; \
@@ -46,16 +57,17 @@ test-python:
 	$(PYTHON) -m pytest -m "not mpi" --color=no
 
 test-mpi:
-	$(MPIRUN) $(PYTHON) -m pytest -m mpi -p no:cacheprovider --color=no
+	OPENBLAS_NUM_THREADS=1 $(MPIRUN) $(PYTHON) -m pytest -m mpi -p no:cacheprovider --color=no
 
 demo: build
 	$(PYTHON) demos/hertz.py --discretization cut --out $(OUT)/hertz
 
-bench: build
+bench: build bench-deps
 	mkdir -p benchmarks/results
 	$(BUILD)/cpp_contact/contact_bench --benchmark_out=benchmarks/results/geometry.json \
 	  --benchmark_out_format=json
 	$(PYTHON) benchmarks/plot_geometry.py benchmarks/results/geometry.json
+	$(PYTHON) benchmarks/work_precision.py --out-dir benchmarks/results
 
 format:
 	clang-format -i cpp_contact/*/*.h cpp_contact/*/*.cpp

@@ -12,6 +12,10 @@ import os
 # helper daemon (for MPI_Comm_spawn, which this code never calls), ~0.4 s of every run's start.
 # Under mpirun the setting has no effect; a user's own value is kept.
 os.environ.setdefault("OMPI_MCA_ess_singleton_isolated", "1")
+# OpenBLAS (the Makefile installs it: MUMPS and the dense contact blocks run 2-3x faster than on
+# the reference BLAS) starts a thread per core; MPI ranks already share the cores.
+if int(os.environ.get("OMPI_COMM_WORLD_SIZE", "1")) > 1:
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 try:
     from . import _cpp

@@ -55,7 +55,7 @@ def test_condensed_equals_factorised(kind):
     assert [s.iterations for s in a.steps] == [s.iterations for s in b.steps]
     # one sparse factorisation for the whole path, one dense Schur update per changed J
     assert a.factorisations == 1 and b.factorisations > 1
-    assert a.linear.schur_factorisations == b.factorisations
+    assert 0 < a.linear.schur_factorisations <= b.factorisations  # none while nothing touches
     assert a.reaction("cylinder_top")[0] == pytest.approx(0.5 * 0.3 * P, rel=1e-9)
 
 
