@@ -13,9 +13,13 @@ dofs of the cells that hold closest points: a few hundred of 1e4-1e6).
   in the (c, c) block, J's Schur complement is S0 + dC_cc: a Newton iteration, a load step or
   a force-control border refactorises only that m x m matrix, and the solve condenses and
   expands through the one sparse factorisation (`_cpp.schur_factor`, `_cpp.schur_update`).
+  Should one dense update take longer than twice that factorisation (m too large for n), it
+  hands over to `Factorised` for the rest of the run.
 
 `choose` picks Condensed where it applies and pays (m well below the dofs), else Factorised.
 """
+
+import time
 
 import numpy as np
 from petsc4py import PETSc
@@ -23,7 +27,7 @@ from petsc4py import PETSc
 from . import _cpp
 
 DEFAULT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
-MAX_CONDENSED = 3000  # dense m x m LU per iteration: near here a sparse refactorisation wins
+MAX_CONDENSED = 6000  # the dense m x m blocks (3 of them) stay below ~1 GB
 
 
 class LinearSolverError(RuntimeError):
@@ -61,31 +65,59 @@ class Factorised:
 
 
 class Condensed:
-    """The bulk factorised once, Newton on the dense Schur complement of the contact dofs."""
+    """The bulk factorised once, Newton on the dense Schur complement of the contact dofs.
+
+    The dense update costs ~m^3 and a sparse factorisation ~n^1.5 (2D): should an update take
+    longer than twice the sparse factorisation (and 50 ms), the solver hands over to `Factorised` for the
+    rest of the run (`name` then says so)."""
 
     name = "condensed"
+    min_handover = 0.05  # s: below this a dense update is never "too slow"
 
-    def __init__(self, problem, dofs):
+    def __init__(self, problem, dofs, petsc_options=None):
+        self.problem, self.petsc_options = problem, petsc_options
+        t0 = time.perf_counter()
         K0 = problem.K.copy()
         K0.zeroRows(problem.bc_global, diag=1.0)
         self.IS = PETSc.IS().createGeneral(np.asarray(dofs, dtype=np.int32), comm=problem.comm)
         self.F, self.S0 = _cpp.schur_factor(K0, self.IS)
         self.K0cc = _dense(K0.createSubMatrix(self.IS, self.IS))
+        self.t_factor = time.perf_counter() - t0
         self.num_dofs = len(dofs)
         self.factorisations = 1  # sparse, once
         self.schur_factorisations = 0  # dense, m x m
-        self.key = None
+        self.key, self.full = None, None
 
     def setup(self, J, key):
+        if self.full is not None:
+            return self.full.setup(J, key)
         if key is not None and key == self.key:
             return
         self.key = key
+        t0 = time.perf_counter()
         dC = _dense(J.createSubMatrix(self.IS, self.IS)) - self.K0cc
         _cpp.schur_update(self.F, self.S0 + dC)
         self.schur_factorisations += 1
+        # m too large for its n (timer noise aside: twice, and 50 ms): refactorise instead
+        if time.perf_counter() - t0 > max(2.0 * self.t_factor, self.min_handover):
+            self.full = Factorised(self.problem, self.petsc_options)
+            self.full.factorisations = self.factorisations
+            self.name = f"factorised (condensed: {self.num_dofs} contact dofs cost more)"
+            self.F = self.S0 = self.K0cc = None
+            return self.full.setup(J, None)
 
     def solve(self, b, x):
+        if self.full is not None:
+            return self.full.solve(b, x)
         self.F.solve(b, x)
+
+    @property
+    def factorisations(self):
+        return self._factorisations if self.full is None else self.full.factorisations
+
+    @factorisations.setter
+    def factorisations(self, n):
+        self._factorisations = n
 
 
 def _dense(A):
@@ -120,7 +152,7 @@ def choose(problem, kind="auto", petsc_options=None):
     if why is None and not 0 < len(dofs) <= min(MAX_CONDENSED, problem.num_dofs // 4):
         why = f"{len(dofs)} contact dofs of {problem.num_dofs}"
     if why is None:
-        return Condensed(problem, dofs)
+        return Condensed(problem, dofs, petsc_options)
     if kind == "condensed":
         raise ValueError(f"linear_solver: 'condensed' does not apply here: {why}")
     return Factorised(problem, petsc_options)

@@ -27,7 +27,7 @@ def scene(kind):
     return hertz_scene(MPI.COMM_WORLD, **size)
 
 
-def mindlin(sc, linear_solver, materials=None):
+def mindlin(sc, linear_solver, materials=None, before=None):
     top_x, top_y = Dirichlet("cylinder_top", 0, 0.0), Dirichlet("cylinder_top", 1, 0.0)
     pb = ContactProblem(
         sc,
@@ -38,6 +38,8 @@ def mindlin(sc, linear_solver, materials=None):
         linear_solver=linear_solver,
         log=lambda *a, **k: None,
     )
+    if before is not None:
+        before(pb)
     protocol.reach_force(pb, top_y, "block_bottom", 1, P, first_guess=-0.1)
     protocol.friction_on(pb, 0.3)
     protocol.reach_force(pb, top_x, "cylinder_top", 0, 0.5 * 0.3 * P, 1e-5, monotone=True)
@@ -75,3 +77,18 @@ def test_nonlinear_bulk_is_factorised():
     laws = {b.tag: NeoHookean(E, NU) for b in sc.bodies}
     with pytest.raises(ValueError, match="nonlinear"):
         mindlin(sc, "condensed", laws)
+
+
+def test_hand_over_when_the_dense_block_costs_more():
+    """A dense update slower than the sparse factorisation: the rest of the run refactorises
+    the full J, with the same answer."""
+    sc = scene("cut")
+
+    def slow(pb):
+        pb.linear.t_factor = pb.linear.min_handover = 0.0  # every dense update "costs more"
+
+    a, b = mindlin(sc, "condensed", before=slow), mindlin(sc, "factorised")
+    assert a.linear.name.startswith("factorised (condensed:")
+    assert a.linear.schur_factorisations == 1 and a.factorisations > 1
+    ua, ub = a.u.x.array, b.u.x.array
+    assert np.abs(ua - ub).max() <= 1e-9 * np.abs(ub).max()
