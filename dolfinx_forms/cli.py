@@ -49,10 +49,13 @@ class DefaultsFormatter(argparse.HelpFormatter):
 
 class DemoParser(argparse.ArgumentParser):
     """argparse with one-line errors (argparse prints usage + error by default), defaults in
-    --help, --verbose, and the result-folder options of :meth:`add_out`."""
+    --help, --verbose, the result-folder options of :meth:`add_out`, and no abbreviated
+    options (an unknown option is an error, never a prefix of another one)."""
 
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("formatter_class", DefaultsFormatter)
+        # no abbreviations: `--h 0.1` to a program without --h would be --help (exit 0)
+        kwargs.setdefault("allow_abbrev", False)
         super().__init__(*args, **kwargs)
         self._out_dest = None
         self.add_argument(
