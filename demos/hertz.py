@@ -45,7 +45,7 @@ OPTIONS = [  # option, kind, default[, help]
     ("--width", "(0, inf)", None, "block width (default max(40, 40 a))"),
     ("--depth", "(0, inf)", None, "block depth (default max(20, 20 a))"),
     ("--zone", "(0, inf)", 1.2, "half-width of the zone meshed at h, in units of the Hertz a"),
-    ("--h-far", "(0, inf)", None, "mesh size far from the contact (default min(R, depth) / 2)"),
+    ("--h-far", "(0, inf)", None, "mesh size far from the contact (default min(R / 2, depth / 2, 100 h))"),
     ("--grading", "(0, inf)", None,
      "size growth away from the zone: slope (body-fitted, default 0.5) or ratio of "
      "neighbouring cells (cut, > 1, default 2)"),
@@ -81,7 +81,8 @@ def scene(run):
     p, cut = run.params, run.params["discretization"] == "cut"
     size = dict(R=p["R"], width=p["width"], depth=p["depth"], h=p["h"], zone=p["zone"])
     size["zone"] *= estimate(p)[1]
-    size["h_far"] = p["h_far"] or min(p["R"], p["depth"]) / 2
+    # the far field coarsens with h, so that its error falls with h's (a fixed h_far: a floor)
+    size["h_far"] = p["h_far"] or min(p["R"] / 2, p["depth"] / 2, 100 * p["h"])
     size["growth"] = p["grading"] or (2.0 if cut else 0.5)
     if cut:  # graded grid, spacing h on the zone; cylinder cut
         return hertz_cut_scene(run.comm, **size)
