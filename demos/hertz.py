@@ -44,7 +44,7 @@ OPTIONS = [  # option, kind, default[, help]
      "largest initial gap covered by the contact surface (default: the gap at x = 1.6 a)"),
     ("--width", "(0, inf)", None, "block width (default max(40, 40 a))"),
     ("--depth", "(0, inf)", None, "block depth (default max(20, 20 a))"),
-    ("--zone", "(0, inf)", 1.2, "half-width of the zone meshed at h, in units of the Hertz a"),
+    ("--zone", "[1, inf)", 1.2, "half-width of the zone meshed at h, in units of the Hertz a"),
     ("--h-far", "(0, inf)", None, "mesh size far from the contact (default min(R / 2, depth / 2, 100 h))"),
     ("--grading", "(0, inf)", None,
      "size growth away from the zone: slope (body-fitted, default 0.5) or ratio of "
@@ -65,8 +65,31 @@ def parse(argv):
     a = p.parse_args(argv)
     if a.tangential > 0 and a.mu == 0:
         p.error("--tangential: a Cattaneo-Mindlin stage needs --mu > 0")
+    if a.mu > 0 and a.tangential == 0:
+        p.error("--mu: friction acts in the tangential stage only: give --tangential r > 0")
     if a.grading is not None and a.discretization == "cut" and not a.grading > 1:
         p.error(f"--grading: the cut grid's growth ratio must be > 1, got {a.grading:g}")
+    # the defaults that depend on the Hertz half-width, then what the scene can mesh
+    hertz_a = estimate(vars(a))[1]
+    a.width, a.depth = a.width or max(40.0, 40 * hertz_a), a.depth or max(20.0, 20 * hertz_a)
+    zone = a.zone * hertz_a
+    given = "--h" if a.h is not None else "--R, --load, --E (h = a/20 of the Hertz a)"
+    a.h = a.h or hertz_a / 20
+    room = {"--R": a.R, "--width": a.width / 2, "--depth": a.depth}
+    name = min(room, key=room.get)
+    if not zone < room[name]:
+        p.error(
+            f"{name}: the zone meshed at h, {a.zone:g} a = {zone:.4g} (a = {hertz_a:.4g}, the "
+            f"Hertz half-width of --load, --R, --E), must lie inside both bodies: "
+            f"below {name.lstrip('-')}{'/2' if name == '--width' else ''} = {room[name]:.4g}"
+        )
+    lo = max(zone / 2000, 1e-5 * max(a.R, a.width, a.depth))  # cells and grading gmsh can do
+    if not lo <= a.h <= zone / 2:
+        p.error(
+            f"{given}: h = {a.h:.4g} outside [{lo:.4g}, {zone / 2:.4g}] (at least 1/2000 of the "
+            f"zone's half-width {zone:.4g} and 1e-5 of the largest body size, at most half the "
+            "zone)"
+        )
     return a
 
 
@@ -139,9 +162,7 @@ SUMMARY = (
 
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
-    a = estimate(vars(args))[1]  # the defaults that depend on the Hertz half-width
-    args.h, args.protocol = args.h or a / 20, PROTOCOL
-    args.width, args.depth = args.width or max(40.0, 40 * a), args.depth or max(20.0, 20 * a)
+    args.protocol = PROTOCOL
     name, reactions = "mindlin" if args.tangential else "hertz", ["block_bottom", "cylinder_top"]
     return run_case(
         name, vars(args), scene, problem, stages, evaluate, reactions=reactions, summary=SUMMARY

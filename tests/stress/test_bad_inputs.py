@@ -27,18 +27,6 @@ ROOT = Path(__file__).resolve().parents[2]
 BATCH = Path(__file__).with_name("cli_batch.py")
 RESULT_NAMES = {".ils_result", "metrics.json", "tractions.csv", "solution.xdmf", "runs"}
 
-# known defects of demos/hertz.py (no mesh-size or geometry bounds before gmsh, --mu ignored
-# without --tangential); strict: remove the mark when the demo refuses the command line
-XFAIL = pytest.mark.xfail(
-    strict=True, reason="demos/hertz.py does not refuse this yet (issue 11, item 4)"
-)
-
-
-def known(*case):
-    """A command line that exposes a known defect (XFAIL)."""
-    return pytest.param(case, marks=XFAIL)
-
-
 # (demo, arguments, the option the message must name[, current folder: "" (the case's
 # folder), "sub" (its empty sub-folder) or "root" (the repository)]). {d}: the case's folder,
 # {root}: the repository root. Without --out in the arguments, `--out {d}/out` is appended.
@@ -131,8 +119,8 @@ CASES = [
     ("four_grains", "--h 1e6", "--h"),
     ("grain_assembly", "--h 1e-300", "--h"),
     ("grain_assembly", "--h 1e6", "--h"),
-    known("hertz", "--h 1e-300", "--h"),
-    known("hertz", "--h 1e6", "--h"),
+    ("hertz", "--h 1e-300", "--h"),
+    ("hertz", "--h 1e6", "--h"),
     # ------------------------------------------------ the rest of the scene
     ("two_blocks", "--displacement 1e300", "--displacement"),
     ("inclined_interface", "--displacement 1e6", "--displacement"),
@@ -145,12 +133,12 @@ CASES = [
     ("four_grains", "--displacement 1", "--displacement"),
     ("grain_assembly", "--steps 0 --shear-steps 0", "--steps"),
     ("patch_test", "--discretization cut --upper-cells 4", "--upper-cells"),
-    known("hertz", "--width 1", "--width"),
-    known("hertz", "--R 1e-300", "--R"),
-    known("hertz", "--load 1e-300", "--load"),
+    ("hertz", "--width 1", "--width"),
+    ("hertz", "--R 1e-300", "--R"),
+    ("hertz", "--load 1e-300", "--load"),
     # ------------------------------------------------ friction without its stage
     ("hertz", "--tangential 0.5 --mu 0", "--tangential"),
-    known("hertz", "--mu 0.3", "--mu"),
+    ("hertz", "--mu 0.3", "--mu"),
     # ------------------------------------------------ unknown options
     ("two_blocks", "--bogus-option 1", "--bogus-option"),
     ("contact_geometry", "--petsc ksp_type=cg", "--petsc"),  # no linear solver there
@@ -299,7 +287,7 @@ def test_bad_command_line(batch, case):
 
 
 def test_enough_command_lines():
-    """Issue 11 asks for 50+ bad command lines; the known failures (xfail) are not counted."""
+    """Issue 11 asks for 50+ bad command lines."""
     counted = [c for c in CASES if not hasattr(c, "marks") or not c.marks]
     assert len(counted) >= 55 and len({_fields(c)[0] for c in counted}) == 10
 
