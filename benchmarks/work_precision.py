@@ -1,33 +1,63 @@
 #!/usr/bin/python3
-"""Work-precision benchmark of the Hertz line-contact demo (frictionless, demo defaults).
+"""Work-precision benchmark of the Hertz line-contact demo (frictionless, demo defaults), and
+the time ratio to GetFEM's nodal P1 contact at equal p(x) error, both from one run.
 
 Runs demos/hertz.py as one subprocess per run (so the timings of the runs are independent)
-at contact mesh sizes h = a/10, a/14, a/20, a/28, a/40 (a: the Hertz half-width of the demo
-defaults, ~1 mm) for each discretization variant, sequentially. Variants: the body-fitted
-(gmsh) path p1-tri, p2-tri, p1-quad, p2-quad (hertz.py [--degree 2] [--quads]) and the cut path
-q1-cut (hertz.py --discretization cut: level sets on a graded structured grid, Q1, hertz.py's
-default ghost penalty); default p1-tri,p1-quad,q1-cut, so one run compares both paths. Writes
+at contact mesh sizes h = a/10, a/14, a/20, a/28, a/40, a/56, a/80 (a: the Hertz half-width of
+the demo defaults, ~1 mm; a/56 and a/80 so that both paths reach 0.5 %) for each
+discretization variant. Variants: the body-fitted (gmsh) path p1-tri, p2-tri, p1-quad, p2-quad
+(hertz.py [--degree 2] [--quads]) and the cut path q1-cut (hertz.py --discretization cut:
+level sets on a graded structured grid, Q1, hertz.py's default ghost penalty); default
+p1-tri,p1-quad,q1-cut, so one run compares both paths.
 
-  <out-dir>/work_precision.json  the runs (h, dofs, phase wall times, Newton iterations,
-                                 errors of a, p0 and p(x) against Hertz), per variant the
-                                 observed convergence rates of each error vs h (least squares
-                                 on log-log) and the time to reach 2 % pressure L2 error
-                                 (log-log interpolation between the bracketing runs);
-                                 cut_vs_conforming: q1-cut's time to 2 % beside the fastest
-                                 conforming variant's;
-  <out-dir>/work_precision.png   pressure L2 error vs wall time and vs dofs, and the stacked
-                                 phase times of every run.
+GetFEM. When `import getfem` works (Debian's python3-getfem; `make bench` installs it) the same
+run also runs benchmarks/getfem_hertz.py (GetFEM's nodal P1 contact between the two bodies,
+force-controlled, the same p(x) error definition: see its docstring), one subprocess per size,
+at h = a/5 ... a/56 (--getfem-divisors), interleaved with our runs size by size so that the
+machine's load falls on both alike. Without GetFEM (or with --no-getfem) a note is printed and
+the comparison is skipped. Times compared: the in-process totals (ours: the demo's phase timer;
+GetFEM: mesh + setup + solve + post), neither counting interpreter start-up nor imports.
 
-Both files are replaced atomically. A run whose demo exits non-zero is recorded with the last
-line of its stderr and left out of the rates and curves. Times are the demo's own phase timer
-(timing_s.total: mesh generation to the end of post-processing, without interpreter start-up
-and file output); the subprocess wall time is recorded beside it as wall_s.
-Running a demo and turning its metrics.json into errors is demos/convergence_study.py's
-run_hertz (shared, with the variants' arguments and the log-log fit).
+Time at a given error, per variant: the least-squares line log(error) vs log(time) over all
+the variant's runs, solved for the error ("fit", flagged when extrapolated: the headline, least
+sensitive to the scatter of single runs: GetFEM's error plateaus near 0.8-1 % and jumps by
++-30 % between neighbouring h), and the log-log interpolation between the first pair of runs
+(by increasing time) that brackets it ("interpolated", the rule of the 2 % figure below).
+Targets: GetFEM's best error (its fastest run within 2 % of its smallest error; GetFEM's time
+there: that run's) and 0.5 %. Ratio = our time / GetFEM's at the same error (< 1: ours is
+faster); when a side does not reach a target within its runs, the interpolated ratio is bounded
+by its largest run's time (lower_bound, upper_bound).
+
+Writes (each file replaced atomically)
+  <out-dir>/work_precision.json  the runs of our variants (h, dofs, phase wall times, Newton
+                                 iterations, errors of a, p0 and p(x) against Hertz), per
+                                 variant the observed convergence rates of each error vs h
+                                 (least squares on log-log) and the time to reach 2 % pressure
+                                 L2 error; cut_vs_conforming: q1-cut's time to 2 % beside the
+                                 fastest conforming variant's; vs_getfem: the ratios below, or
+                                 why they were skipped;
+  <out-dir>/work_precision.png   pressure L2 error vs wall time and vs dofs (GetFEM's runs
+                                 too), and the stacked phase times of our runs;
+  <out-dir>/work_precision_getfem.json  GetFEM's runs, the times at the targets per variant
+                                 (interpolated and fit) and the ratios, per variant and per
+                                 path (its fastest variant);
+  <out-dir>/work_precision_getfem.csv   every run of this benchmark run, ours and GetFEM's:
+                                 variant, path, h, dofs, times, Newton iterations, errors;
+  <out-dir>/work_precision_getfem.png   p(x) error vs time of every variant and GetFEM, the
+                                 targets and the fits.
+
+A run whose demo exits non-zero is recorded with the last line of its stderr and left out of
+the rates and curves. Times are the demo's own phase timer (timing_s.total: mesh generation to
+the end of post-processing, without interpreter start-up and file output); the subprocess wall
+time is recorded beside it as wall_s. Running a demo and turning its metrics.json into errors
+is demos/convergence_study.py's run_hertz (shared, with the variants' arguments and the log-log
+fit).
 
 Usage: /usr/bin/python3 benchmarks/work_precision.py [--quick] [--variants p1-tri,p1-quad,q1-cut]
                                                      [--out-dir benchmarks/results] [--timeout S]
-  --quick: a/10, a/14, a/20 only (default variants p1-tri,q1-cut), a smoke run of ~1 minute.
+                                                     [--no-getfem] [--getfem-divisors 5,...,56]
+  --quick: a/10, a/14, a/20 only (default variants p1-tri,q1-cut; GetFEM a/7, a/10, a/14,
+  a/20), a smoke run of ~1 minute.
 """
 
 import hashlib
@@ -38,9 +68,13 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
+import numpy as np
+
 from dolfinx_forms.cli import DemoParser
+from dolfinx_forms.study import last_line
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -63,8 +97,14 @@ HERTZ_DEFAULTS = study.CASE  # passed explicitly to every run
 VARIANTS = study.VARIANTS  # name -> extra demo arguments
 ERRORS, PHASES = study.ERRORS, study.PHASES
 loglog_rate = study.loglog_rate
-DIVISORS = (10, 14, 20, 28, 40)
+DIVISORS = (10, 14, 20, 28, 40, 56, 80)
 QUICK_DIVISORS = (10, 14, 20)
+GETFEM = ROOT / "benchmarks" / "getfem_hertz.py"
+GETFEM_VARIANT = "getfem-p1"  # GetFEM's runs in the tables and plots
+GETFEM_DIVISORS = (5, 7, 10, 12, 14, 17, 20, 24, 28, 34, 40, 56)
+QUICK_GETFEM_DIVISORS = (7, 10, 14, 20)
+TARGET_LOW = 0.005  # the second error of the GetFEM comparison (the first: GetFEM's best)
+BEST_TIE = 0.02  # GetFEM runs within 2 % of its smallest error are ties: the fastest is "best"
 DEFAULT_VARIANTS = "p1-tri,p1-quad,q1-cut"  # p2-tri is selectable (about 8 minutes alone)
 QUICK_VARIANTS = "p1-tri,q1-cut"
 TARGET = 0.02  # pressure L2 error of the time-to-precision figure
@@ -86,13 +126,25 @@ def parse(argv):
     p.add_argument(
         "--out-dir",
         default=str(ROOT / "benchmarks" / "results"),
-        help="folder of work_precision.json and .png (default benchmarks/results)",
+        help="folder of work_precision.{json,png} and work_precision_getfem.{json,csv,png}",
     )
     p.add_argument(
         "--timeout",
         type=float,
         default=3600.0,
         help="seconds before one demo run is killed and recorded as failed",
+    )
+    p.add_argument(
+        "--no-getfem",
+        action="store_true",
+        help="skip the GetFEM comparison (default: run it when `import getfem` works)",
+    )
+    p.add_argument(
+        "--getfem-divisors",
+        default=None,
+        help="comma-separated k of GetFEM's mesh sizes h = a/k (default "
+        f"{','.join(map(str, GETFEM_DIVISORS))}; --quick: "
+        f"{','.join(map(str, QUICK_GETFEM_DIVISORS))})",
     )
     a = p.parse_args(argv)
     names = [
@@ -111,6 +163,21 @@ def parse(argv):
         p.error(f"--timeout must be in (0, inf), got {a.timeout}")
     a.variants = names
     a.divisors = QUICK_DIVISORS if a.quick else DIVISORS
+    if a.getfem_divisors is None:
+        a.getfem_divisors = QUICK_GETFEM_DIVISORS if a.quick else GETFEM_DIVISORS
+    else:
+        try:
+            ks = [float(k) for k in a.getfem_divisors.split(",")]
+        except ValueError:
+            ks = []
+        if len(ks) < 2 or not all(math.isfinite(k) and 1 <= k <= 400 for k in ks):
+            p.error(
+                "--getfem-divisors: at least 2 comma-separated numbers k in [1, 400] "
+                f"(h = a/k), got {a.getfem_divisors!r}"
+            )
+        if len(set(ks)) != len(ks):
+            p.error("--getfem-divisors: a size is listed twice")
+        a.getfem_divisors = tuple(sorted(int(k) if k.is_integer() else k for k in ks))
     return a
 
 
@@ -169,6 +236,48 @@ def run_one(variant, divisor, h, timeout):
     return rec
 
 
+def getfem_available():
+    """(True, None) when `import getfem` works in a fresh interpreter, else (False, why)."""
+    try:
+        r = subprocess.run(
+            [sys.executable, "-c", "import getfem"],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+    except (OSError, subprocess.SubprocessError) as e:
+        return False, f"cannot start {sys.executable}: {e}"
+    if r.returncode != 0:
+        return False, last_line(r.stderr, f"import getfem: exit status {r.returncode}")
+    return True, None
+
+
+def run_getfem(divisor, h, timeout):
+    """One benchmarks/getfem_hertz.py run (its own process); the record has the keys of ours
+    (h, num_dofs, timing_s with total, errors, newton_iterations_total, wall_s, ok)."""
+    rec = dict(variant=GETFEM_VARIANT, path="getfem", h_divisor=divisor, h=h)
+    cmd = [sys.executable, str(GETFEM), "--h", repr(h), "--json"]
+    rec["command"] = " ".join(cmd[1:])
+    t0 = time.perf_counter()
+    try:
+        proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return dict(rec, ok=False, wall_s=timeout, error=f"killed after the {timeout:g} s timeout")
+    rec["wall_s"] = time.perf_counter() - t0
+    if proc.returncode != 0:
+        return dict(rec, ok=False, error=last_line(proc.stderr, f"exit {proc.returncode}"))
+    try:  # GetFEM prints its own lines on stdout: the result is the last one
+        res = json.loads(proc.stdout.strip().splitlines()[-1])
+        rec.update(ok=True, **res)
+        rec["newton_iterations_total"] = int(res["newton_iterations"])
+        rec["errors"] = {k: float(v) for k, v in res["errors"].items()}
+    except (IndexError, KeyError, TypeError, ValueError) as e:
+        return dict(
+            rec, ok=False, error=f"getfem_hertz.py exited 0 but its output is unusable: {e}"
+        )
+    return rec
+
+
 def time_to_target(runs, target=TARGET):
     """Total time (and dofs) at which the pressure L2 error reaches `target`, interpolated
     log-log between the first pair of runs (by increasing time) that brackets it."""
@@ -202,6 +311,115 @@ def time_to_target(runs, target=TARGET):
             )
             return out
     out["method"] = f"not reached (smallest error {min(e):.4g})"
+    return out
+
+
+def fit_time(runs, target):
+    """Time at which the least-squares line log(error) vs log(total time) over the runs meets
+    `target` (None with fewer than 2 runs or a non-decreasing line); extrapolated: outside the
+    runs' error range."""
+    t = [r["timing_s"]["total"] for r in runs]
+    e = [r["errors"]["pressure_rel_l2_error"] for r in runs]
+    out = dict(time_s=None, slope=None, extrapolated=None)
+    if len(runs) < 2 or len(set(t)) < 2:
+        return out
+    slope, icpt = (float(v) for v in np.polyfit(np.log(t), np.log(e), 1))
+    out["slope"] = slope
+    if slope < 0:
+        out["time_s"] = float(math.exp((math.log(target) - icpt) / slope))
+        out["extrapolated"] = not (min(e) <= target <= max(e))
+    return out
+
+
+def time_at(runs, target):
+    """Time at the p(x) error `target` of one variant's successful runs: interpolated (the
+    first bracketing pair by time, time_to_target), the largest run time when not reached, and
+    the log-log fit."""
+    tt = time_to_target(runs, target)
+    return dict(
+        target=target,
+        interpolated_s=tt["time_s"] if tt["reached"] else None,
+        dofs=tt["num_dofs"],
+        method=tt["method"],
+        largest_run_s=max((r["timing_s"]["total"] for r in runs), default=None),
+        fit=fit_time(runs, target),
+    )
+
+
+def ratio(ours, theirs):
+    """ours / theirs of two time_at records: value when both reached the target, else the bound
+    the largest run's time gives (lower_bound: ours did not reach it; upper_bound: GetFEM did
+    not); fit: the ratio of the fitted times."""
+    o, g = ours["interpolated_s"], theirs["interpolated_s"]
+    out = dict(value=None, lower_bound=None, upper_bound=None, fit=None)
+    if o is not None and g is not None:
+        out["value"] = o / g
+    elif o is None and g is not None and ours["largest_run_s"]:
+        out["lower_bound"] = ours["largest_run_s"] / g
+    elif g is None and o is not None and theirs["largest_run_s"]:
+        out["upper_bound"] = o / theirs["largest_run_s"]
+    fo, fg = ours["fit"]["time_s"], theirs["fit"]["time_s"]
+    if fo is not None and fg is not None:
+        out["fit"] = fo / fg
+    return out
+
+
+def compare_getfem(runs, getfem_runs, variants):
+    """Times of every variant and of GetFEM at GetFEM's best error and at TARGET_LOW, the
+    ratios ours / GetFEM per variant and per path (the path's fastest variant at the target)."""
+    g_ok = [r for r in getfem_runs if r["ok"]]
+    if not g_ok:
+        return dict(skipped="no successful GetFEM run")
+    e_min = min(r["errors"]["pressure_rel_l2_error"] for r in g_ok)
+    tied = [r for r in g_ok if r["errors"]["pressure_rel_l2_error"] <= (1 + BEST_TIE) * e_min]
+    best = min(tied, key=lambda r: r["timing_s"]["total"])  # the fastest of the (near) ties
+    targets = {
+        "getfem_best": best["errors"]["pressure_rel_l2_error"],
+        "low": TARGET_LOW,
+    }
+    out = dict(
+        getfem_best_run=dict(
+            h_divisor=best["h_divisor"],
+            num_dofs=best["num_dofs"],
+            time_s=best["timing_s"]["total"],
+            pressure_rel_l2_error=best["errors"]["pressure_rel_l2_error"],
+        ),
+        targets=targets,
+        times={},
+        ratios={},
+        paths={},
+    )
+    for name, e in targets.items():
+        g = time_at(g_ok, e)
+        if name == "getfem_best":  # GetFEM's own time there: its best run's
+            g.update(interpolated_s=best["timing_s"]["total"], dofs=best["num_dofs"])
+            g["method"] = f"GetFEM's best run (h = a/{best['h_divisor']})"
+        times = {GETFEM_VARIANT: g}
+        for v in variants:
+            ok = [r for r in runs if r["variant"] == v and r["ok"]]
+            times[v] = time_at(ok, e)
+        out["times"][name] = times
+        out["ratios"][name] = {v: ratio(times[v], g) for v in variants}
+        paths = {}
+        for path in ("conforming", "cut"):
+            members = [v for v in variants if study.variant_path(v) == path]
+            rs = out["ratios"][name]
+            fit = [(times[v]["fit"]["time_s"], v) for v in members if rs[v]["fit"] is not None]
+            got = [(times[v]["interpolated_s"], v) for v in members if rs[v]["value"] is not None]
+            low = [(rs[v]["lower_bound"], v) for v in members if rs[v]["lower_bound"] is not None]
+            upp = [(rs[v]["upper_bound"], v) for v in members if rs[v]["upper_bound"] is not None]
+            entry = {}
+            if fit:  # the path's fastest variant by the fits
+                v = min(fit)[1]
+                entry["fit"] = dict(variant=v, ratio=rs[v]["fit"])
+            for kind, cand in (("value", got), ("upper_bound", upp), ("lower_bound", low)):
+                if cand:  # by the interpolation: fastest reached, else the tightest bound
+                    v = min(cand)[1]
+                    entry["interpolated"] = dict(variant=v, **{kind: rs[v][kind]})
+                    break
+            if entry:
+                paths[path] = entry
+        out["paths"][name] = paths
     return out
 
 
@@ -291,6 +509,7 @@ COLORS = {
     "p1-quad": "tab:green",
     "p2-quad": "tab:red",
     "q1-cut": "tab:purple",
+    GETFEM_VARIANT: "k",
 }
 PHASE_COLORS = {
     "mesh": "tab:gray",
@@ -349,6 +568,12 @@ def plot(path, data):
         if tt["reached"]:
             ax_t.plot(tt["time_s"], 100 * TARGET, "*", ms=12, color=c, mec="k", mew=0.5)
             ax_n.plot(tt["num_dofs"], 100 * TARGET, "*", ms=12, color=c, mec="k", mew=0.5)
+    g_ok = sorted((r for r in data.get("getfem_runs", []) if r["ok"]), key=lambda r: -r["h"])
+    if g_ok:  # GetFEM's nodal P1 from the same run (benchmarks/getfem_hertz.py)
+        e = [100 * r["errors"]["pressure_rel_l2_error"] for r in g_ok]
+        kw = dict(color=COLORS[GETFEM_VARIANT], lw=1, ms=4, label="GetFEM nodal P1")
+        ax_t.loglog([r["timing_s"]["total"] for r in g_ok], e, "D-", **kw)
+        ax_n.loglog([r["num_dofs"] for r in g_ok], e, "D-", **kw)
     for ax, xl in ((ax_t, "total wall time of the run (s)"), (ax_n, "number of dofs")):
         ax.axhline(100 * TARGET, ls="--", color="k", lw=0.8)
         ax.set_xlabel(xl)
@@ -410,6 +635,223 @@ def plot(path, data):
     plt.close(fig)
 
 
+def getfem_version():
+    try:
+        r = subprocess.run(
+            ["dpkg-query", "-W", "-f", "${Version}", "python3-getfem"],
+            capture_output=True,
+            text=True,
+            timeout=30,
+        )
+        return r.stdout.strip() or None
+    except (OSError, subprocess.SubprocessError):
+        return None
+
+
+def getfem_data(data, getfem_runs, divisors, vs):
+    """work_precision_getfem.json: GetFEM's runs and rates, our runs (compact), the times at
+    the targets and the ratios, with their definitions."""
+    ok = sorted((r for r in getfem_runs if r["ok"]), key=lambda r: -r["h"])
+    keys = ("variant", "path", "h_divisor", "h", "num_dofs", "newton_iterations_total")
+    ours = [
+        dict(
+            **{k: r.get(k) for k in keys},
+            total_s=r["timing_s"]["total"],
+            pressure_rel_l2_error=r["errors"]["pressure_rel_l2_error"],
+        )
+        for r in data["runs"]
+        if r["ok"]
+    ]
+    return dict(
+        benchmark="hertz work-precision against GetFEM's nodal P1 contact (frictionless)",
+        a_hertz=data["a_hertz"],
+        hertz_defaults=data["hertz_defaults"],
+        getfem_package=getfem_version(),
+        getfem_script="benchmarks/getfem_hertz.py",
+        getfem_script_sha256=hashlib.sha256(GETFEM.read_bytes()).hexdigest()[:12],
+        getfem_h_divisors=list(divisors),
+        our_h_divisors=data["h_divisors"],
+        variants=data["variants"],
+        git=data["git"],
+        code_sha256=data["code_sha256"],
+        code_changed_during_benchmark=data["code_changed_during_benchmark"],
+        load_average_at_start=data["load_average_at_start"],
+        load_average_at_end=os.getloadavg()[0] if hasattr(os, "getloadavg") else None,
+        cpu_count=data["cpu_count"],
+        definitions=dict(
+            error="p(x) relative L2 error against Hertz at the computed load, both sides "
+            "(dolfinx_forms/compare.py; GetFEM: the P1 interpolant of its lumped nodal "
+            "pressures at 2 Gauss points per slave segment, see benchmarks/getfem_hertz.py)",
+            time="in-process total: ours the demo's timing_s.total, GetFEM mesh + setup + "
+            "solve + post; neither counts interpreter start-up nor imports (wall_s: the "
+            "subprocess, all included)",
+            targets="getfem_best: the p(x) error of GetFEM's best run, the fastest of its runs "
+            f"whose error is within {100 * BEST_TIE:g} % of its smallest (ties: its error "
+            f"plateaus), GetFEM's time there: that run's; low: {TARGET_LOW:g}",
+            interpolated="log-log interpolation of time vs error between the first pair of "
+            "runs (by increasing time) that brackets the target (an upper bound when the "
+            "fastest run is already below it)",
+            fit="least-squares line log(error) vs log(time) over all the variant's runs, "
+            "solved for the target (extrapolated: outside the runs' errors)",
+            ratio="our time / GetFEM's at the same error (< 1: ours faster); value when both "
+            "reached the target; lower_bound: ours did not reach it (our largest run's time / "
+            "GetFEM's); upper_bound: GetFEM did not (our time / GetFEM's largest run's); "
+            "fit: ratio of the fitted times",
+            paths="per path: fit, the variant with the smallest fitted time at the target "
+            "and its fitted ratio (the headline figure: least sensitive to the scatter of "
+            "single runs); interpolated, the fastest variant that reached the target within "
+            "its runs (else the tightest bound)",
+        ),
+        getfem_runs=getfem_runs,
+        getfem_summary=dict(
+            runs_ok=len(ok),
+            runs_failed=len(getfem_runs) - len(ok),
+            rates_vs_h={
+                k: loglog_rate([r["h"] for r in ok], [r["errors"][k] for r in ok]) for k in ERRORS
+            },
+            errors_decrease_monotonically={
+                k: study.decreasing([r["errors"][k] for r in ok]) for k in ERRORS
+            },
+        ),
+        our_runs=ours,
+        comparison=vs,
+    )
+
+
+CSV_COLUMNS = (
+    "variant path h_divisor h num_dofs total_s mesh_s solve_s wall_s newton_iterations "
+    "pressure_rel_l2_error half_width_rel_error peak_pressure_rel_error ok error"
+).split()
+
+
+def write_csv(path, runs):
+    """One line per run (ours and GetFEM's), CSV_COLUMNS."""
+    import csv
+
+    def row(r):
+        t, e = r.get("timing_s", {}), r.get("errors", {})
+        vals = dict(
+            variant=r["variant"],
+            path=r.get("path"),
+            h_divisor=r["h_divisor"],
+            h=f"{r['h']:.6g}",
+            num_dofs=r.get("num_dofs"),
+            total_s=t.get("total"),
+            mesh_s=t.get("mesh"),
+            solve_s=t.get("solve"),
+            wall_s=r.get("wall_s"),
+            newton_iterations=r.get("newton_iterations_total"),
+            ok=r["ok"],
+            error=r.get("error", ""),
+            **{k: e.get(k) for k in ERRORS},
+        )
+        return [
+            f"{v:.6g}" if isinstance(v, float) else ("" if v is None else v)
+            for v in (vals[c] for c in CSV_COLUMNS)
+        ]
+
+    def writer(tmp):
+        with open(tmp, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(CSV_COLUMNS)
+            for r in runs:
+                w.writerow(row(r))
+
+    write_atomic(path, writer)
+
+
+def ratio_text(r):
+    """A ratio record as text: 0.52, > 3.1 (lower bound), < 0.4 (upper bound) or -."""
+    if r.get("value") is not None:
+        return f"{r['value']:.2f}"
+    if r.get("lower_bound") is not None:
+        return f"> {r['lower_bound']:.2f}"
+    if r.get("upper_bound") is not None:
+        return f"< {r['upper_bound']:.2f}"
+    return "-"
+
+
+def path_text(entry):
+    """A path's ratios (compare_getfem paths) as text: the fitted one, then the interpolated."""
+    parts = []
+    if "fit" in entry:
+        parts.append(f"fit {entry['fit']['ratio']:.2f} ({entry['fit']['variant']})")
+    if "interpolated" in entry:
+        r = entry["interpolated"]
+        parts.append(f"interpolated {ratio_text(r)} ({r['variant']})")
+    return ", ".join(parts) or "-"
+
+
+def plot_getfem(png, gdata, runs):
+    """p(x) error vs in-process time: every variant, GetFEM, the two targets and the fits."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    vs = gdata["comparison"]
+    fig, ax = plt.subplots(figsize=(9, 6.5))
+    groups = {v: [r for r in runs if r["variant"] == v and r["ok"]] for v in gdata["variants"]}
+    groups[GETFEM_VARIANT] = [r for r in gdata["getfem_runs"] if r["ok"]]
+    for v, rs in groups.items():
+        rs = sorted(rs, key=lambda r: -r["h"])  # coarse to fine
+        if not rs:
+            continue
+        t = np.array([r["timing_s"]["total"] for r in rs])
+        e = np.array([100 * r["errors"]["pressure_rel_l2_error"] for r in rs])
+        c = COLORS.get(v, "k")
+        path = "GetFEM nodal P1" if v == GETFEM_VARIANT else study.variant_path(v)
+        ax.loglog(t, e, "o-" if v != GETFEM_VARIANT else "D-", color=c, label=f"{v} ({path})")
+        fit = vs.get("times", {}).get("low", {}).get(v, {}).get("fit", {})
+        if fit.get("slope") is not None:  # the fitted line over the runs' time range
+            tt = np.array([t.min(), t.max()])
+            k = np.polyfit(np.log(t), np.log(e), 1)
+            ax.loglog(tt, np.exp(np.polyval(k, np.log(tt))), ":", color=c, lw=1)
+        for r in rs:
+            ax.annotate(
+                f"a/{r['h_divisor']:g}",
+                (r["timing_s"]["total"], 100 * r["errors"]["pressure_rel_l2_error"]),
+                fontsize=6,
+                xytext=(3, 2),
+                textcoords="offset points",
+                color=c,
+            )
+    for name, ls in (("getfem_best", "--"), ("low", "-.")):
+        e = vs.get("targets", {}).get(name)
+        if e is None:
+            continue
+        label = "GetFEM's best" if name == "getfem_best" else f"{100 * e:g} %"
+        ax.axhline(100 * e, ls=ls, color="gray", lw=0.8, label=f"target: {label}")
+        for v, tv in vs["times"][name].items():
+            if tv["interpolated_s"] is not None:
+                ax.plot(
+                    tv["interpolated_s"],
+                    100 * e,
+                    "*",
+                    ms=11,
+                    color=COLORS.get(v, "k"),
+                    mec="k",
+                    mew=0.5,
+                )
+    ax.set_xlabel("in-process time of the run (s)")
+    ax.set_ylabel("p(x) relative L2 error against Hertz (%)")
+    ax.grid(True, which="both", lw=0.3)
+    ax.legend(fontsize=8)
+    plain_log_labels(ax)
+    lines = []
+    for name in ("getfem_best", "low"):
+        for path, r in vs.get("paths", {}).get(name, {}).items():
+            lines.append(f"{path} / GetFEM at {name}: {path_text(r)}")
+    ax.set_title(
+        "Hertz, frictionless: ours vs GetFEM nodal P1, one run (stars: time at the targets)\n"
+        + "\n".join(lines),
+        fontsize=8,
+    )
+    fig.tight_layout()
+    write_atomic(png, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
+    plt.close(fig)
+
+
 def fmt(x, spec):
     return "-" if x is None else format(x, spec)
 
@@ -456,6 +898,49 @@ def report(data):
         )
 
 
+def report_getfem(gdata):
+    """GetFEM's runs, then per target the times of every variant and the ratios."""
+    print("GetFEM nodal P1 (benchmarks/getfem_hertz.py), same run:")
+    print(
+        f"  {'h':>8} {'dofs':>8} {'total s':>8} {'mesh s':>7} {'solve s':>8} {'Newton':>6} "
+        f"{'p L2 err':>9} {'a err':>7}"
+    )
+    for r in gdata["getfem_runs"]:
+        if not r["ok"]:
+            print(f"  {r['h']:8.5f}  FAILED: {r['error']}")
+            continue
+        t, e = r["timing_s"], r["errors"]
+        print(
+            f"  {r['h']:8.5f} {r['num_dofs']:8d} {t['total']:8.2f} {t['mesh']:7.2f} "
+            f"{t['solve']:8.2f} {r['newton_iterations_total']:6d} "
+            f"{e['pressure_rel_l2_error']:9.3%} {e['half_width_rel_error']:7.3%}"
+        )
+    vs = gdata["comparison"]
+    if "skipped" in vs:
+        print(f"  comparison skipped: {vs['skipped']}")
+        return
+    for name, e in vs["targets"].items():
+        label = "GetFEM's best error" if name == "getfem_best" else "error"
+        print(f"time to {label} {e:.3%}: interpolated (fit) and ours / GetFEM, fit first:")
+        for v, tv in vs["times"][name].items():
+            r = vs["ratios"][name].get(v)
+            ft = tv["fit"]["time_s"]
+            fit = "-" if ft is None else f"{ft:.2f}" + ("*" if tv["fit"]["extrapolated"] else "")
+            t = tv["interpolated_s"]
+            t = (
+                f"> {tv['largest_run_s']:.2f}"
+                if t is None and tv["largest_run_s"]
+                else fmt(t, ".2f")
+            )
+            ratio_s = (
+                "" if r is None else f"  ratio fit {fmt(r['fit'], '.2f')}, interp. {ratio_text(r)}"
+            )
+            print(f"  {v:10} {t:>8} s ({fit} s){ratio_s}")
+        for path, r in vs["paths"][name].items():
+            print(f"  {path} path / GetFEM: {path_text(r)}")
+    print("  (*: the fit extrapolated beyond the runs' errors)")
+
+
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
     out_dir = Path(args.out_dir)
@@ -467,21 +952,40 @@ def main(argv=None):
     a = hertz_half_width()
     git = git_head()
     load0 = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
-    runs = []
-    for v in args.variants:
-        for k in args.divisors:
-            h = a / k
-            print(f"[work_precision] {v} h = a/{k} = {h:.5f} ...", flush=True)
+    if args.no_getfem:
+        with_getfem, why = False, "--no-getfem"
+    else:
+        with_getfem, why = getfem_available()
+    if not with_getfem:
+        print(
+            f"[work_precision] note: GetFEM comparison skipped ({why}); `make bench` installs "
+            "python3-getfem",
+            flush=True,
+        )
+    # size by size (coarse to fine), ours then GetFEM's: the machine's load falls on both alike
+    jobs = [(k, v) for k in args.divisors for v in args.variants]
+    if with_getfem:
+        jobs += [(k, GETFEM_VARIANT) for k in args.getfem_divisors]
+    jobs.sort(key=lambda j: j[0])
+    runs, getfem_runs = [], []
+    for k, v in jobs:
+        h = a / k
+        print(f"[work_precision] {v} h = a/{k} = {h:.5f} ...", flush=True)
+        if v == GETFEM_VARIANT:
+            rec = run_getfem(k, h, args.timeout)
+            getfem_runs.append(rec)
+        else:
             rec = run_one(v, k, h, args.timeout)
             runs.append(rec)
-            if rec["ok"]:
-                print(
-                    f"    {rec['num_dofs']} dofs, {rec['timing_s']['total']:.2f} s, "
-                    f"p L2 error {rec['errors']['pressure_rel_l2_error']:.3%}",
-                    flush=True,
-                )
-            else:
-                print(f"    FAILED: {rec['error']}", flush=True)
+        if rec["ok"]:
+            print(
+                f"    {rec['num_dofs']} dofs, {rec['timing_s']['total']:.2f} s, "
+                f"p L2 error {rec['errors']['pressure_rel_l2_error']:.3%}",
+                flush=True,
+            )
+        else:
+            print(f"    FAILED: {rec['error']}", flush=True)
+    runs.sort(key=lambda r: (args.variants.index(r["variant"]), -r["h"]))
     data = dict(
         benchmark="hertz work-precision (frictionless, demos/hertz.py defaults)",
         a_hertz=a,
@@ -509,16 +1013,35 @@ def main(argv=None):
         summary={v: summarize(v, [r for r in runs if r["variant"] == v]) for v in args.variants},
     )
     data["cut_vs_conforming"] = compare_paths(data["summary"])
+    if with_getfem:
+        vs = compare_getfem(runs, getfem_runs, args.variants)
+        gdata = getfem_data(data, getfem_runs, args.getfem_divisors, vs)
+        data["getfem_runs"] = getfem_runs
+        data["vs_getfem"] = dict(
+            file="work_precision_getfem.json",
+            **{k: vs.get(k) for k in ("targets", "paths", "ratios", "skipped") if k in vs},
+        )
+    else:
+        data["vs_getfem"] = dict(skipped=why)
     json_path, png_path = out_dir / "work_precision.json", out_dir / "work_precision.png"
     write_json(json_path, data)
     plot(png_path, data)
+    if with_getfem:
+        gpaths = [out_dir / f"work_precision_getfem.{x}" for x in ("json", "csv", "png")]
+        write_json(gpaths[0], gdata)
+        write_csv(gpaths[1], runs + getfem_runs)
+        plot_getfem(gpaths[2], gdata, runs)
     report(data)
+    if with_getfem:
+        report_getfem(gdata)
     if data["code_changed_during_benchmark"]:
         print(
             "warning: the demo/package sources changed during the benchmark "
             f"(digests {', '.join(data['code_sha256'])}); runs are not comparable"
         )
     print(f"results in {json_path.resolve()} and {png_path.resolve()}")
+    if with_getfem:
+        print(f"GetFEM comparison in {', '.join(str(q.resolve()) for q in gpaths)}")
     return 0
 
 
