@@ -27,7 +27,7 @@ def scene(kind):
     return hertz_scene(MPI.COMM_WORLD, **size)
 
 
-def mindlin(sc, linear_solver, materials=None, before=None):
+def hertz_problem(sc, linear_solver, materials=None):
     top_x, top_y = Dirichlet("cylinder_top", 0, 0.0), Dirichlet("cylinder_top", 1, 0.0)
     pb = ContactProblem(
         sc,
@@ -38,11 +38,20 @@ def mindlin(sc, linear_solver, materials=None, before=None):
         linear_solver=linear_solver,
         log=lambda *a, **k: None,
     )
+    return pb, top_x, top_y
+
+
+def mindlin(sc, linear_solver, materials=None, before=None):
+    """Normal force P (frictionless), friction on, tangential force Q = 0.5 mu P; returns the
+    problem and the reactions reached by the two force stages (each right after its stage)."""
+    pb, top_x, top_y = hertz_problem(sc, linear_solver, materials)
     if before is not None:
         before(pb)
-    protocol.reach_force(pb, top_y, "block_bottom", 1, P, first_guess=-0.1)
+    protocol.reach_force(pb, top_y, "block_bottom", 1, P, first_guess=-0.05)
+    reached = [pb.reaction("block_bottom")[1]]
     protocol.friction_on(pb, 0.3)
     protocol.reach_force(pb, top_x, "cylinder_top", 0, 0.5 * 0.3 * P, 1e-5, monotone=True)
+    pb.reached = reached + [pb.reaction("cylinder_top")[0]]
     return pb
 
 
@@ -92,3 +101,13 @@ def test_hand_over_when_the_dense_block_costs_more():
     assert a.linear.schur_factorisations == 1 and a.factorisations > 1
     ua, ub = a.u.x.array, b.u.x.array
     assert np.abs(ua - ub).max() <= 1e-9 * np.abs(ub).max()
+
+
+def test_force_control_with_a_nonlinear_law():
+    """Neo-Hookean bodies (finite strain): a full factorisation per iteration, and the force
+    control's gradient k = J^T 1_b takes the nonlinear bulk rows: each force reached to 1e-9
+    (the normal one right after its stage: at finite strain the tangential stage shifts it)."""
+    sc = scene("cut")
+    pb = mindlin(sc, "auto", {b.tag: NeoHookean(E, NU) for b in sc.bodies})
+    assert pb.linear.name == "factorised"
+    assert pb.reached == pytest.approx([P, 0.5 * 0.3 * P], rel=1e-9)
