@@ -87,8 +87,9 @@ def parse(argv):
     if not lo <= a.h <= zone / 2:
         p.error(
             f"{given}: h = {a.h:.4g} outside [{lo:.4g}, {zone / 2:.4g}] (at least 1/2000 of the "
-            f"zone's half-width {zone:.4g} and 1e-5 of the largest body size, at most half the "
-            "zone)"
+            f"zone's half-width {zone:.4g} and 1e-5 of the largest body size "
+            f"{max(a.R, a.width, a.depth):.4g}, at most half the zone; a small load needs "
+            "smaller --R, --width, --depth)"
         )
     return a
 
