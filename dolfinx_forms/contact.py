@@ -160,6 +160,31 @@ def search_box(body_i, body_j, band):
     return np.array([lo, hi])
 
 
+def near_box(box, body_i, body_j, band, step, dx):
+    """The part of the search `box` where both bodies can come within `band` of each other: both
+    level sets on a coarse grid of spacing `step`, the nodes where max(phi_i, phi_j) <= band
+    + 2 * (cell diagonal) kept (a signed distance, or its lower bound for an intersection, is
+    1-Lipschitz), their bounding box grown by 2 steps, within `box`, its corner on box[0] + dx
+    Z^2 (the fine grid's nodes, hence Gamma_c, are the ones of the whole box). The fine grid of
+    the pair then covers the contact and not the bodies' whole overlap (Hertz: |x| < 2 a of a
+    20 R wide overlap). For bodies with exact shapes or obstacles only (a grid level set is
+    known on its grid)."""
+    n = np.maximum(np.ceil((box[1] - box[0]) / step).astype(int), 1)
+    grid = _cpp.StructuredGrid(
+        np.linspace(box[0, 0], box[1, 0], n[0] + 1), np.linspace(box[0, 1], box[1, 1], n[1] + 1)
+    )
+    nodes = grid.nodes()
+    phi = [np.asarray(body_levelset(grid, b).values).reshape(-1) for b in (body_i, body_j)]
+    near = np.maximum(*phi) <= band + 2 * np.hypot(*((box[1] - box[0]) / n))
+    if not near.any():
+        return box
+    q = nodes[near]
+    grow = 2 * (box[1] - box[0]) / n
+    lo = np.maximum(q.min(axis=0) - grow, box[0])
+    lo = box[0] + np.floor((lo - box[0]) / dx + 1e-9) * dx
+    return np.array([lo, np.minimum(q.max(axis=0) + grow, box[1])])
+
+
 def has_exact_shape(body):
     """True if the body's shape is an analytic signed distance (`_cpp.Shape`); False for a body
     given by a grid level set (`_cpp.LevelSet`), e.g. one built from a polyline or evolved."""
@@ -336,6 +361,8 @@ def pair_geometry(
     box = search_box(bi, bj, band + 4 * dx)
     if box is None:
         return None
+    if all(isinstance(b, RigidObstacle) or has_exact_shape(b) for b in (bi, bj)):
+        box = near_box(box, bi, bj, band + 4 * dx, 8 * dx, dx)
     if lattice_origin is not None:
         # nodes on the lattice origin + dx Z^2: the pair grids of mirror-image pairs are
         # mirror images (symmetric assemblies stay symmetric), whatever the boxes

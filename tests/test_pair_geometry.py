@@ -107,3 +107,28 @@ def test_cell_contours_binding():
     np.testing.assert_array_equal(c["segments"][1], [[0, 1], [3, 2]])
     assert np.isnan(c["t"][2]).all()
     np.testing.assert_array_equal(c["edges"], [[0, 1], [1, 3], [2, 3], [0, 2]])
+
+
+def test_near_box_leaves_the_contact_unchanged(hertz, monkeypatch):
+    """The fine pair grid on the part of the search box where both bodies come within the band
+    (contact.near_box: |x| < ~2 a instead of the 20 R wide overlap) gives the same Gamma_c
+    (same lattice: weights and normals to round-off) and the same closest points to the
+    projection's tolerance (1e-8 relative: its start differs)."""
+    from dolfinx_forms import contact
+
+    scene, V = hertz
+    band = 0.2
+    fast = pair_geometry(V, scene, (0, 1), band)
+    calls = []
+    monkeypatch.setattr(contact, "near_box", lambda box, *a: calls.append(box) or box)
+    full = pair_geometry(V, scene, (0, 1), band)
+    assert calls, "near_box not called for exact shapes"
+    whole = calls[0]
+    assert len(fast.weights) == len(full.weights)
+    for k in ("weights", "normals"):
+        np.testing.assert_allclose(getattr(fast, k), getattr(full, k), rtol=0, atol=1e-12)
+    for k in ("p_i", "p_j", "g_n0"):
+        np.testing.assert_allclose(getattr(fast, k), getattr(full, k), rtol=0, atol=1e-6 * 0.1)
+    # the contact lies well inside the kept part, which is a fraction of the whole width
+    x = fast.p_i[:, 0]
+    assert np.ptp(x) < 0.5 * (whole[1, 0] - whole[0, 0])
