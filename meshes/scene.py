@@ -19,6 +19,8 @@ rank 0, where the contact geometry is computed (a Python cell partitioner, see
 ``contact_box`` the box is derived from the contact pairs (:func:`pairs_contact_boxes`: the
 overlap of each pair's bounding boxes inflated by CONTACT_BOX_MARGIN h_contact, one box per
 pair); ``contact_box=False`` selects DOLFINx's default graph partitioner (no contact on rank 0).
+With {"boxes", "owners"} (the multi-step MPM) each box goes to its own rank, its cells owned
+elsewhere sent there as ghost cells.
 """
 
 from __future__ import annotations
