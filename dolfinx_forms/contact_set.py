@@ -37,7 +37,10 @@ def pair_key(pair, obstacle=None):
 
 class ContactSet:
     """Contact points of `scene.pairs` on rank `rank` (empty elsewhere; or a {pair_key: rank}
-    map: each pair on its own rank, the others on rank 0), penalty eps_n, eps_t
+    map: each pair on its own rank, the others on rank 0; the cells of a pair may be ghost
+    cells there: its dofs are local indices, ghosts included, and the residual and tangent
+    rows of ghost dofs reach their owners by the callers' reverse scatter and PETSc's
+    off-process assembly), penalty eps_n, eps_t
     (eq 51) and friction coefficient mu (0: frictionless, no history). obstacles:
     `obstacles.RigidObstacle`s, each paired with every body it may touch (its `bodies`); their
     prescribed motion at load level lam is set by `set_load`."""
@@ -84,12 +87,14 @@ class ContactSet:
             for i, b in enumerate(scene.bodies)
             if ob.bodies is None or b.tag in np.atleast_1d(ob.bodies)
         ]
-        for pair, ob in candidates:
+        self.index = []  # of each pair held here in the candidates (scene.pairs, then obstacles)
+        for c, (pair, ob) in enumerate(candidates):
             if owner(pair_key(pair, ob)) != me:
                 continue
             g = pair_geometry(V, scene, pair, band, obstacle=ob, **kw)
             if g is not None:
                 self.pairs.append(g)
+                self.index.append(c)
         self._lam = None
         # friction history, slip origin and multipliers live at the law points (the multiplier
         # nodes, or the points): `PairGeometry.num_law_points`

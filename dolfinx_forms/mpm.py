@@ -288,11 +288,12 @@ class ImplicitMPM:
 
     def contact_ranks(self, pairs):
         """In parallel: the box of each pair's contact region (grid nodes within the band of
-        both bodies, grown by the band and 2 h: Gamma_c, its closest points and their cells lie inside) and
-        the rank that computes it. Pairs go to ranks in contiguous groups along the domain's
-        longest axis; pairs whose boxes touch share a rank (the partitioner gives each box's
-        cells to its rank). Returns ({pair_key: rank}, {"boxes", "owners"}) or (None, None)
-        on one rank."""
+        both bodies, grown by the band and 2 h: Gamma_c, its closest points and their cells lie
+        inside) and the rank that computes it. Pairs go to ranks in contiguous groups along the
+        domain's longest axis, each pair on its own rank whatever its neighbours: the
+        partitioner gives each box's cells to its rank, as owned cells or, where another box
+        already claimed them, as ghost cells (`meshes.scene.contact_partitioner`). Returns
+        ({pair_key: rank}, {"boxes", "owners"}) or (None, None) on one rank."""
         size = self.comm.size
         if size == 1:
             return None, None
@@ -324,13 +325,6 @@ class ImplicitMPM:
         order = np.argsort(0.5 * (boxes[:, 0, axis] + boxes[:, 1, axis]), kind="stable")
         owners = np.empty(len(keys), np.int32)
         owners[order] = (np.arange(len(keys)) * size) // len(keys)
-        lo, hi = boxes[:, 0], boxes[:, 1]
-        touch = np.all((lo[:, None] <= hi[None]) & (hi[:, None] >= lo[None]), axis=2)
-        while True:  # touching boxes take the smaller rank, until nothing changes
-            merged = np.where(touch, owners[None, :], size).min(axis=1).astype(np.int32)
-            if np.array_equal(merged, owners):
-                break
-            owners = merged
         ranks = {k: int(r) for k, r in zip(keys, owners)}
         return ranks, {"boxes": boxes, "owners": owners}
 
@@ -448,8 +442,9 @@ class ImplicitMPM:
             if cs.mu > 0:
                 e_t = s["g_t"] - cs.history[k].committed
                 self.friction[keys[k]] = (g.points.copy(), np.asarray(e_t, float).copy())
-        # contact lives on one rank: share the records
-        pairs = [p for lst in self.comm.allgather(pairs) for p in lst]
+        # each pair lives on one rank: share the records, in the order of one rank
+        gathered = self.comm.allgather(list(zip(cs.index, pairs)))
+        pairs = [p for _, p in sorted((q for lst in gathered for q in lst), key=lambda q: q[0])]
         self.friction = {k: v for d in self.comm.allgather(self.friction) for k, v in d.items()}
         # contact resultants on each body: +sum w (tau_n n + tau_t t) on side i, the opposite on
         # side j; moment about the body's material-point centroid

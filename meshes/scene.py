@@ -19,6 +19,8 @@ rank 0, where the contact geometry is computed (a Python cell partitioner, see
 ``contact_box`` the box is derived from the contact pairs (:func:`pairs_contact_boxes`: the
 overlap of each pair's bounding boxes inflated by CONTACT_BOX_MARGIN h_contact, one box per
 pair); ``contact_box=False`` selects DOLFINx's default graph partitioner (no contact on rank 0).
+With {"boxes", "owners"} (the multi-step MPM) each box goes to its own rank, its cells owned
+elsewhere sent there as ghost cells.
 """
 
 from __future__ import annotations
@@ -256,12 +258,14 @@ def contact_partitioner(x: np.ndarray, cells: np.ndarray, cell_name: str, contac
     intersects `contact_box` ((2, 2), or (k, 2, 2): a union of boxes) go to rank 0, topped up
     with the cells nearest to the box up to an equal share; the rest is cut into equal chunks
     along the longest axis of the bounding box for ranks 1..nparts-1. With contact_box a dict
-    {"boxes": (k, 2, 2), "owners": (k,)} each box's cells go to its owner instead (contact
-    computed by pair on several ranks) and the rest fills the ranks up to equal shares.
-    GhostMode.none: one
-    destination per cell; shared_facet (and shared_vertex, treated alike): owner first, then
-    the owners of its edge neighbours (the ranks that must hold it as a ghost). If the box
-    holds more than 1/nparts of the cells, rank 0 simply gets more than its share.
+    {"boxes": (k, 2, 2), "owners": (k,)} the contact is computed by pair on several ranks:
+    each cell hit by a box is owned by the rank of the first box that hits it and is a ghost
+    cell on the ranks of the other boxes that hit it (every rank holds all the cells of its
+    boxes, whatever their owner); the rest fills the ranks up to equal shares.
+    GhostMode.none: one destination per cell (the dict form still sends the box ghosts);
+    shared_facet (and shared_vertex, treated alike): owner first, then the owners of its edge
+    neighbours (the ranks that must hold it as a ghost). If the box holds more than 1/nparts of
+    the cells, rank 0 simply gets more than its share.
     """
     owners = None
     if isinstance(contact_box, dict):  # {"boxes": (k, 2, 2), "owners": (k,)}: one rank per box
@@ -282,8 +286,11 @@ def contact_partitioner(x: np.ndarray, cells: np.ndarray, cell_name: str, contac
             lo, hi = cell_bboxes(x, cells)
             centroid = 0.5 * (lo + hi)
             owner[:] = -1
+            box_cells = []  # (cells, rank) of each box, last box first
             for box, r in zip(boxes[::-1], owners[::-1] % nparts):
-                owner[np.all((lo <= box[1]) & (hi >= box[0]), axis=1)] = r
+                hit = np.flatnonzero(np.all((lo <= box[1]) & (hi >= box[0]), axis=1))
+                owner[hit] = r
+                box_cells.append((hit, r))
             rest = np.flatnonzero(owner < 0)
             axis = int(np.argmax(np.ptp(centroid, axis=0)))
             rest = rest[np.argsort(centroid[rest, axis], kind="stable")]
@@ -313,11 +320,18 @@ def contact_partitioner(x: np.ndarray, cells: np.ndarray, cell_name: str, contac
             others = others[np.argsort(centroid[others, axis], kind="stable")]
             for r, chunk in enumerate(np.array_split(others, nparts - 1)):
                 owner[chunk] = r + 1
-        if ghost_mode == dolfinx.mesh.GhostMode.none or nparts == 1:
+        # ghosts: (cell, rank) of the box cells owned by another rank than the box's
+        ga, gb = np.zeros(0, np.int64), np.zeros(0, np.int32)
+        if nparts > 1 and owners is not None:
+            ga = np.concatenate([ga] + [hit for hit, r in box_cells])
+            gb = np.concatenate([gb] + [np.full(len(hit), r, np.int32) for hit, r in box_cells])
+        if nparts == 1 or (ghost_mode == dolfinx.mesh.GhostMode.none and len(ga) == 0):
             return AdjacencyList_int32(owner.reshape(-1, 1))
-        # ghosts: each cell is also sent to the owners of its edge neighbours
-        a, b = _facet_neighbours(cells, cell_name)
-        ga, gb = np.concatenate([a, b]), np.concatenate([owner[b], owner[a]])
+        if ghost_mode != dolfinx.mesh.GhostMode.none:
+            # each cell is also sent to the owners of its edge neighbours
+            a, b = _facet_neighbours(cells, cell_name)
+            ga = np.concatenate([ga, a, b])
+            gb = np.concatenate([gb, owner[b], owner[a]])
         keep = gb != owner[ga]
         dests = np.unique(np.stack([ga[keep], gb[keep]], axis=1), axis=0)  # sorted by cell
         counts = 1 + np.bincount(dests[:, 0], minlength=n)

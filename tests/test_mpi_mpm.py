@@ -1,7 +1,9 @@
 """The implicit MPM in parallel: a coarse Brazilian disc over 10 steps gives the same platen
 forces, half-widths, material-point state and level sets on 2 ranks as on 1 (each rank also runs
 it on COMM_SELF), to 1e-8 relative. Points and level sets are replicated on every rank; the
-contact zones are kept on rank 0 by the scene's contact boxes."""
+contact zones are kept on rank 0 by the scene's contact boxes. Grain assemblies: each contact
+pair is computed on its own rank (the cells of its box owned elsewhere are ghost cells there),
+also in a dense packing whose boxes chain across the whole assembly."""
 
 import numpy as np
 import pytest
@@ -42,13 +44,13 @@ def test_brazilian_disc_two_ranks_match_one():
     assert np.max(diff) <= 1e-8 * par.h
 
 
-def assembly(comm, steps=2, mu=np.tan(np.radians(15))):
+def assembly(comm, steps=2, mu=np.tan(np.radians(15)), n=9):
     from test_mpm import quiet
 
     from dolfinx_forms.mpm import ImplicitMPM, MPMBody
     from meshes.assembly import grain_assembly
 
-    grid, bodies, plates, build, _, _ = grain_assembly(comm, 9, h=0.5, aspect=1.1, overlap=0.01)
+    grid, bodies, plates, build, _, _ = grain_assembly(comm, n, h=0.5, aspect=1.1, overlap=0.01)
     for name, v in (
         ("plate_left", (0.01, 0)),
         ("plate_right", (-0.01, 0)),
@@ -70,16 +72,9 @@ def assembly(comm, steps=2, mu=np.tan(np.radians(15))):
     return sim, [sim.step() for _ in range(steps)]
 
 
-@pytest.mark.mpi
-def test_assembly_contact_by_pair_on_two_ranks_matches_one():
-    """Nine grains in rigid plates, mu = tan 15 deg: on 2 ranks each pair's contact is computed
-    on the rank that owns its cells (both ranks hold pairs); plate forces, pair forces and
-    Newton iterations agree with one rank to 1e-8 over two steps. (Newton's cycling test once
-    compared each rank's own active set: a rank whose part repeated cut the step back.)"""
-    par, rp = assembly(MPI.COMM_WORLD)
-    ser, rs = assembly(MPI.COMM_SELF)
-    held = MPI.COMM_WORLD.allgather(len(par.problem.contact.pairs))
-    assert min(held) > 0, held
+def assert_same_steps(rp, rs):
+    """Step records of 2 ranks and of 1 agree: Newton iterations, plate forces and every pair's
+    normal and tangential force to 1e-8, the pairs in the same order."""
     for a, b in zip(rp, rs):
         assert a["newton_iterations"] == b["newton_iterations"]
         for ob in a["obstacles"]:
@@ -87,8 +82,61 @@ def test_assembly_contact_by_pair_on_two_ranks_matches_one():
                 assert a["obstacles"][ob][c] == pytest.approx(
                     b["obstacles"][ob][c], rel=1e-8, abs=1e-8
                 )
-        fa = {(p["body_i"], p["body_j"]): p["normal_force"] for p in a["pairs"]}
-        fb = {(p["body_i"], p["body_j"]): p["normal_force"] for p in b["pairs"]}
-        assert fa.keys() == fb.keys()
-        scale = max(fb.values())
-        assert max(abs(fa[k] - fb[k]) for k in fa) <= 1e-8 * scale
+        assert [(p["body_i"], p["body_j"]) for p in a["pairs"]] == [
+            (p["body_i"], p["body_j"]) for p in b["pairs"]
+        ]
+        scale = max(p["normal_force"] for p in b["pairs"])
+        for c in ("normal_force", "tangential_force"):
+            diff = max(abs(p[c] - q[c]) for p, q in zip(a["pairs"], b["pairs"]))
+            assert diff <= 1e-8 * scale, (c, diff, scale)
+
+
+@pytest.mark.mpi
+def test_assembly_contact_by_pair_on_two_ranks_matches_one():
+    """Nine grains in rigid plates, mu = tan 15 deg: on 2 ranks each pair's contact is computed
+    on its own rank (both ranks hold pairs); plate forces, pair forces and Newton iterations
+    agree with one rank to 1e-8 over two steps. (Newton's cycling test once compared each
+    rank's own active set: a rank whose part repeated cut the step back.)"""
+    par, rp = assembly(MPI.COMM_WORLD)
+    ser, rs = assembly(MPI.COMM_SELF)
+    held = MPI.COMM_WORLD.allgather(len(par.problem.contact.pairs))
+    assert min(held) > 0, held
+    assert_same_steps(rp, rs)
+
+
+@pytest.mark.mpi
+def test_dense_assembly_pairs_split_evenly_over_two_ranks():
+    """25 grains on a hexagonal lattice, every neighbour touching: the pairs' contact boxes
+    chain across the whole packing, yet each rank computes half of the pairs (contiguous groups
+    along the longest axis; the cells of a pair's box owned by the other rank are ghost cells
+    here). Pair forces and plate forces (1e-8) and the displacements carried by the material
+    points (1e-8 of the largest) agree with one rank over two steps."""
+    comm = MPI.COMM_WORLD
+    par, rp = assembly(comm, n=25)
+    ser, rs = assembly(MPI.COMM_SELF, n=25)
+    held = comm.allgather(len(par.problem.contact.pairs))
+    total = len(ser.problem.contact.pairs)
+    assert sum(held) == total
+    assert max(held) - min(held) <= 1, held
+    imap = par.scene.mesh.topology.index_map(2)
+    # box cells reach the other rank as ghosts: contact rows of ghost dofs are assembled there
+    pb = par.problem
+    nloc = pb.V.dofmap.index_map.size_local
+    blocks = [d for g in pb.contact.pairs for d in g.quadrature.coupling_dofs()]
+    on_ghosts = int(np.sum(np.concatenate(blocks) >= nloc)) if blocks else 0
+    assert comm.allreduce(imap.num_ghosts) > 0
+    assert comm.allreduce(on_ghosts) > 0
+    assert_same_steps(rp, rs)
+    # the last step's displacement increment of every body on the grid nodes (the FE solution
+    # extended off the body), and the points it moved
+    du = max(np.max(np.abs(v)) for v in ser.grid_increments.values())
+    assert du > 0
+    for name, v in ser.grid_increments.items():
+        assert np.max(np.abs(par.grid_increments[name] - v)) <= 1e-8 * du, name
+    for tag in par.points:
+        p, s = par.points[tag], ser.points[tag]
+        op = np.lexsort(np.round(p.x.T / 1e-9))
+        os_ = np.lexsort(np.round(s.x.T / 1e-9))
+        assert np.max(np.abs(p.x[op] - s.x[os_])) <= 1e-8 * du
+        scale = np.max(np.abs(s.stress))
+        assert np.max(np.abs(p.stress[op] - s.stress[os_])) <= 1e-8 * scale
