@@ -66,7 +66,6 @@ benchmarks/results/work_precision_getfem.{json,csv,png} (benchmarks/work_precisi
 import argparse
 import json
 import math
-import os
 import sys
 import time
 
@@ -81,15 +80,6 @@ FAC = 0.75  # gmsh target in the zone, in units of h (meshes/hertz.py's first tr
 BAND = 1.6  # slave arc |x| <= 1.6 a (demos/hertz.py's contact band: the gap at x = 1.6 a)
 MASTER = 1.5  # master half-width in slave half-widths (covers every slave projection)
 GAUSS = 2  # Gauss points per slave segment (demos/hertz.py --gauss default)
-GMSH_OPTIONS = {  # quiet, sizes from the field only (meshes/scene.py's choices)
-    "General.Terminal": 0,
-    "Geometry.AutoCoherence": 0,
-    "Mesh.MeshSizeFromPoints": 0,
-    "Mesh.MeshSizeFromCurvature": 0,
-    "Mesh.MeshSizeExtendFromBoundary": 0,
-    "Mesh.ElementOrder": 1,
-    "Mesh.RecombineAll": 0,
-}
 
 
 def hertz(P=LOAD):
@@ -99,36 +89,15 @@ def hertz(P=LOAD):
     return E_star, a, 2 * P / (math.pi * a)
 
 
-def _gmsh_running(gmsh):
-    """gmsh 4.8 has no isInitialized(): model.list() is [] before the first initialize and
-    raises after a finalize, printing to fd 2 (silenced)."""
-    sys.stderr.flush()
-    saved, null = os.dup(2), os.open(os.devnull, os.O_WRONLY)
-    os.dup2(null, 2)
-    try:
-        return len(gmsh.model.list()) > 0
-    except Exception:
-        return False
-    finally:
-        os.dup2(saved, 2)
-        os.close(saved)
-        os.close(null)
-
-
 def mesh_bodies(h, zone, h_far, growth):
     """gmsh P1 triangles of the cylinder and of the block: [(points 2 x n, triangles 3 x m)] in
     that order; target FAC h on |x|, |y| <= zone, growing with slope `growth` up to h_far. The
     two bodies have separate vertices at the origin (no shared node)."""
-    import gmsh
+    from mpi4py import MPI
 
-    own = not _gmsh_running(gmsh)
-    if own:
-        gmsh.initialize()
-    saved = {k: gmsh.option.getNumber(k) for k in GMSH_OPTIONS}
-    for k, v in GMSH_OPTIONS.items():
-        gmsh.option.setNumber(k, v)
-    gmsh.model.add("getfem_hertz")
-    try:
+    from meshes.scene import gmsh_model  # quiet, sizes from the field only; cleaned up after
+
+    with gmsh_model(MPI.COMM_SELF, "getfem_hertz") as gmsh:
         geo, W = gmsh.model.geo, WIDTH / 2
         c = [geo.addPoint(x, y, 0.0) for x, y in ((-R, R), (0, 0), (R, R), (0, R))]
         arcs = [geo.addCircleArc(c[0], c[3], c[1]), geo.addCircleArc(c[1], c[3], c[2])]
@@ -155,12 +124,6 @@ def mesh_bodies(h, zone, h_far, growth):
             used, tri = np.unique(enodes[0].astype(np.int64), return_inverse=True)
             out.append((xy[:, used], tri.reshape(-1, 3).T))
         return out
-    finally:
-        gmsh.model.remove()
-        for k, v in saved.items():
-            gmsh.option.setNumber(k, v)
-        if own:
-            gmsh.finalize()
 
 
 def solve(
