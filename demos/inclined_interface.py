@@ -76,16 +76,7 @@ def parse(argv):
         "inclined_interface.py", __doc__, "results/inclined_interface", OPTIONS, cells=CELLS
     )
     a = p.parse_args(argv)
-    if a.h < SIZE / 2000:
-        p.error(
-            f"--h: must be >= {SIZE / 2000:g} mm (at most 2000 cells across the {SIZE:g} mm "
-            f"square), got {a.h}"
-        )
-    if a.displacement > 0.1 * SIZE:
-        p.error(
-            f"--displacement: must be <= {0.1 * SIZE:g} mm (a tenth of the {SIZE:g} mm square: "
-            f"small strain), got {a.displacement}"
-        )
+    cli.check_scale(p, a, SIZE, "square")
     return a
 
 

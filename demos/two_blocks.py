@@ -68,17 +68,8 @@ SUPPORTS = (
 def parse(argv):
     p = cli.demo_parser("two_blocks.py", __doc__, "results/two_blocks", OPTIONS, cells=CELLS)
     a = p.parse_args(argv)
-    width, height = SIZES["width_lower"], 2 * SIZES["height"]
-    if a.h < width / 2000:
-        p.error(
-            f"--h: must be >= {width / 2000:g} mm (at most 2000 cells across the {width:g} mm "
-            f"block), got {a.h}"
-        )
-    if a.displacement > 0.1 * height:
-        p.error(
-            f"--displacement: must be <= {0.1 * height:g} mm (a tenth of the {height:g} mm "
-            f"stack: small strain), got {a.displacement}"
-        )
+    cli.check_scale(p, a, SIZES["width_lower"], "block", displacement=False)
+    cli.check_scale(p, a, 2 * SIZES["height"], "stack")
     return a
 
 

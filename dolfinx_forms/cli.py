@@ -367,6 +367,22 @@ def demo_parser(prog, doc, out, options=(), discretization=True, petsc=True, cel
     return p
 
 
+def check_scale(parser, args, size, what, max_cells=2000, displacement=True):
+    """Refuse (parser.error, exit 2) a mesh finer than `max_cells` cells across `size` (mm, the
+    scene's `what`) and, with `displacement`, a --displacement above a tenth of `size`
+    (small strain): what a scene can mesh and the small-strain kinematics can carry."""
+    if args.h < size / max_cells:
+        parser.error(
+            f"--h: must be >= {size / max_cells:g} mm (at most {max_cells} cells across the "
+            f"{size:g} mm {what}), got {args.h}"
+        )
+    if displacement and args.displacement > 0.1 * size:
+        parser.error(
+            f"--displacement: must be <= {0.1 * size:g} mm (a tenth of the {size:g} mm {what}: "
+            f"small strain), got {args.displacement}"
+        )
+
+
 def add_enforcement(parser):
     """--enforcement: penalty (eqs 8, 12) or augmented Lagrangian (Uzawa, seed 003)."""
     parser.add_argument(
