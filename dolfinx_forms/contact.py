@@ -18,7 +18,12 @@ the reference configuration; Newton only changes u in the gaps (eqs 27-30). For 
    `ContactQuadrature` for the C++ kernel (eq 48);
 6. optionally (`multipliers`), the multiplier nodes along Gamma_c (`multiplier_nodes`): one
    traction per node, piecewise constant (P0) or linear (P1) along the contact surface's
-   curves, about h apart: a pressure space the trace can carry.
+   curves, about h apart: a pressure space the trace can carry. The quadrature is then of
+   mortar type: Gamma_c's pieces are split where a closest point passes into another cell of
+   its body (`label_breaks`, bisection) and at the multiplier elements' ends
+   (`multiplier_breaks`), and cut where both bodies end (`beyond_end`), so that each piece
+   integrates a smooth integrand (`_cpp.segment_quadrature`): the patch test is exact on
+   non-matching meshes.
 """
 
 from dataclasses import dataclass
@@ -93,6 +98,94 @@ def surface_chains(pieces, tol):
     return chains
 
 
+def chain_arcs(pieces, tol):
+    """Arc length along the chains of (m, 2, 2) `pieces` (`surface_chains`): per piece the arc
+    length at its start, that start point (a piece may run against its chain), its chain, and
+    the chains' lengths."""
+    arc, start = np.zeros(len(pieces)), np.zeros((len(pieces), 2))
+    chain_of, lengths = np.zeros(len(pieces), np.int64), []
+    for c, chain in enumerate(surface_chains(pieces, tol)):
+        s = 0.0
+        for k, rev in chain:
+            a, b = pieces[k][::-1] if rev else pieces[k]
+            arc[k], start[k], chain_of[k] = s, a, c
+            s += np.linalg.norm(b - a)
+        lengths.append(s)
+    return arc, start, chain_of, np.array(lengths)
+
+
+def multiplier_breaks(pieces, length, tol):
+    """The ends of the multiplier elements of `multiplier_nodes` (each chain of arc length L in
+    n = round(L / length) equal elements) that fall inside the (m, 2, 2) `pieces`: (piece,
+    parameter t in (0, 1) from the piece's first end) pairs, for `split_segments`."""
+    arc, start, chain_of, lengths = chain_arcs(pieces, tol)
+    n_el = np.round(lengths / length).astype(np.int64)
+    piece, t = [], []
+    for k in range(len(pieces)):
+        n, L = n_el[chain_of[k]], lengths[chain_of[k]]
+        if n < 2:
+            continue
+        a, b = pieces[k]
+        length_k = np.linalg.norm(b - a)
+        ends = np.arange(1, n) * (L / n) - arc[k]  # element ends, from the piece's start
+        ends = ends[(ends > tol) & (ends < length_k - tol)] / length_k
+        forward = np.allclose(start[k], a, atol=tol, rtol=0)
+        piece += [k] * len(ends)
+        t += list(ends if forward else 1.0 - ends)
+    return np.array(piece, np.int64), np.array(t)
+
+
+def split_segments(pieces, cells, piece, t, tol):
+    """(m, 2, 2) pieces (and their grid cells) cut at the parameters t of `piece`: the pieces
+    in order, each split into its sub-pieces. Cuts closer than tol (a length) to an end or to
+    another cut are skipped: no sub-piece is shorter than tol (its ends would join no chain)."""
+    order = np.lexsort((t, piece))
+    piece, t = piece[order], t[order]
+    out, out_cells = [], []
+    for k in range(len(pieces)):
+        a, b = pieces[k]
+        step = tol / max(np.linalg.norm(b - a), 1e-300)
+        tk = [0.0]
+        for c in t[np.searchsorted(piece, k) : np.searchsorted(piece, k, "right")]:
+            if c - tk[-1] > step and c < 1.0 - step:
+                tk.append(c)
+        tk = np.array(tk + [1.0])
+        x = a + tk[:, None] * (b - a)
+        out.append(np.stack([x[:-1], x[1:]], axis=1))
+        out_cells.append(np.full(len(tk) - 1, cells[k], np.int32))
+    return np.concatenate(out), np.concatenate(out_cells)
+
+
+def label_breaks(pieces, labels, tol, iterations=48):
+    """Where the integer labels of the points of the (m, 2, 2) `pieces` change along them
+    (`labels(points)` -> (n, k), e.g. the cells that hold the closest points on each body):
+    the first change along each piece, by bisection to 2^-iterations of it. Labels are read
+    tol (a length: `split_segments` makes no piece shorter) inside the ends, so a change
+    closer to an end is ignored. One change per piece and round: call it again on the split
+    pieces for more. Returns (piece, t) pairs for `split_segments`."""
+    a, b = pieces[:, 0], pieces[:, 1]
+    inset = np.minimum(tol / np.maximum(np.linalg.norm(b - a, axis=1), 1e-300), 0.25)[:, None]
+    la, lb = labels(a + inset * (b - a)), labels(b - inset * (b - a))
+    k = np.flatnonzero(np.any(la != lb, axis=1))
+    lo, hi = inset[k, 0], 1.0 - inset[k, 0]
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        same = np.all(labels(a[k] + mid[:, None] * (b[k] - a[k])) == la[k], axis=1)
+        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+    return k, 0.5 * (lo + hi)
+
+
+def beyond_end(points, closest, normals, tol):
+    """True where a point of Gamma_c lies past the end of a body's face: the offset to its
+    closest point runs more along Gamma_c than across it (`normals`: Gamma_c's). Inside the
+    face's shadow the offset is the gap, across Gamma_c up to the angle between the bodies'
+    normals; past a corner that ends the face it runs along Gamma_c."""
+    d = np.asarray(points) - np.asarray(closest)
+    across = np.abs(np.einsum("ij,ij->i", d, normals))
+    along = np.abs(normals[:, 0] * d[:, 1] - normals[:, 1] * d[:, 0])
+    return along > across + tol
+
+
 def multiplier_nodes(surface, kind, length, tol):
     """Multiplier nodes of the contact surface's points (`_cpp.contact_surface`'s dict, points
     filtered): along each chain of pieces (`surface_chains`), of arc length L, n = round(L /
@@ -104,18 +197,7 @@ def multiplier_nodes(surface, kind, length, tol):
     pieces = surface["segments"]
     used = np.unique(surface["segment"])
     local = np.searchsorted(used, surface["segment"])
-    arc = np.zeros(len(used))  # arc length at each piece's start, along its chain
-    start = np.zeros((len(used), 2))
-    chain_of = np.zeros(len(used), np.int64)
-    lengths = []
-    for c, chain in enumerate(surface_chains(pieces[used], tol)):
-        s = 0.0
-        for k, rev in chain:
-            a, b = pieces[used[k]][::-1] if rev else pieces[used[k]]
-            arc[k], start[k], chain_of[k] = s, a, c
-            s += np.linalg.norm(b - a)
-        lengths.append(s)
-    lengths = np.array(lengths)
+    arc, start, chain_of, lengths = chain_arcs(pieces[used], tol)
     x = surface["points"]
     s = arc[local] + np.linalg.norm(x - start[local], axis=1)
     c = chain_of[local]
@@ -139,7 +221,7 @@ def multiplier_nodes(surface, kind, length, tol):
     reached = np.zeros(int(n_nodes.sum()), bool)
     reached[nodes[weights > 0]] = True
     new = np.cumsum(reached) - 1
-    weights[nodes >= 0] = np.where(reached[nodes[nodes >= 0]], weights[nodes >= 0], 0.0)
+    weights[nodes >= 0] = np.where(reached[nodes[nodes >= 0]], weights[nodes >= 0], tol)
     nodes = np.where((nodes >= 0) & (weights > 0), new[np.maximum(nodes, 0)], -1).astype(np.int32)
     swap = nodes[:, 0] < 0  # the first node must exist
     nodes[swap] = nodes[swap][:, ::-1]
@@ -401,14 +483,68 @@ def pair_geometry(
     }
     if len(s["weights"]) == 0:
         return None
+    degree = V.ufl_element().degree()
+    dofmap = V.dofmap.list.array.reshape(-1, V.dofmap.dof_layout.num_dofs)
+    max_outside = 0.5 * h if max_outside is None else max_outside
+    cut = getattr(scene, "cut", None)
+    locators = [
+        None  # rigid side: no dofs, its motion is prescribed (u_j_prescribed)
+        if body is obstacle
+        else (
+            GridLocator(scene.mesh, scene.cell_tags, body.tag, cut, degree)
+            if cut is not None  # structured grid: O(1) location by index
+            else BodyLocator(scene.mesh, scene.cell_tags, body.tag, scene.cell_type, degree)
+        )
+        for body in (bi, bj)
+    ]
+
+    def project(points, scale=h):
+        return [
+            closest_points(b, phi, points, scale, exact=projection == "auto")
+            for b, phi in ((bi, phi_i), (bj, phi_j))
+        ]
+
     mult = (None, None)
     if multipliers is not None:
         length = h if multiplier_length is None else multiplier_length
-        mult = multiplier_nodes(s, multipliers, length, 1e-7 * dx)
-    proj = [
-        closest_points(b, phi, s["points"], h, exact=projection == "auto")
-        for b, phi in ((bi, phi_i), (bj, phi_j))
-    ]
+        tol = 1e-10 * dx  # shortest piece; chain ends join within it
+        # mortar-type integration: Gamma_c's pieces split at the multiplier elements' ends and
+        # where a closest point moves into another cell of its body, so that each piece
+        # integrates a smooth integrand (a hat times the traces of both bodies' bases): the
+        # contact terms are then exact for a flat interface on non-matching meshes
+        used = np.unique(s["segment"])
+        segs, cells = s["segments"][used], s["cells"][used]
+
+        phi_int = _cpp.intermediate_levelset(phi_i, phi_j)
+
+        def labels(points):
+            """Per body the cell that holds the closest point; whether the point lies past the
+            ends of both bodies (`beyond_end`)."""
+            n = np.asarray(phi_int.evaluate(points)[1])
+            n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+            # exact shapes' gradients by differences of 1e-7 scale: fine enough near corners
+            proj = [pr["points"] for pr in project(points, 1e-3 * h)]
+            cells = [
+                np.zeros(len(points), np.int32) if loc is None else loc.locate(p, max_outside)[0]
+                for loc, p in zip(locators, proj)
+            ]
+            past = [beyond_end(points, p, n, 1e-9 * dx) for p in proj]
+            return np.stack(cells + [past[0] & past[1]], axis=1)
+
+        for _ in range(6):  # a piece (h / grid_refine) rarely holds more than one change
+            piece, t = label_breaks(segs, labels, tol)
+            if len(piece) == 0:
+                break
+            segs, cells = split_segments(segs, cells, piece, t, tol)
+        # where both bodies end (the corners of two blocks), so does Gamma_c: the closing
+        # level set's sign, which clipped it, is off by its reinitialisation error (~dx / 40)
+        if len(segs):
+            on = labels(0.5 * (segs[:, 0] + segs[:, 1]))[:, 2] == 0
+            segs, cells = segs[on], cells[on]
+        segs, cells = split_segments(segs, cells, *multiplier_breaks(segs, length, tol), tol)
+        s = _cpp.segment_quadrature(phi_int, segs, cells.astype(np.int32), num_gauss)
+        mult = multiplier_nodes(s, multipliers, length, tol)
+    proj = project(s["points"])
     for name, pr in zip((bi.name, bj.name), proj):
         if not np.all(pr["converged"]):
             bad = np.flatnonzero(~pr["converged"])[0]
@@ -421,19 +557,11 @@ def pair_geometry(
     zero = np.zeros_like(p_i)  # reference configuration: g_n = g_n0 (eq 28)
     g_n0 = _cpp.compute_gaps(p_i, p_j, zero, zero, normals, tangents)["g_n0"]
 
-    degree = V.ufl_element().degree()
-    dofmap = V.dofmap.list.array.reshape(-1, V.dofmap.dof_layout.num_dofs)
-    max_outside = 0.5 * h if max_outside is None else max_outside
     sides = []
-    cut = getattr(scene, "cut", None)
-    for body, p in ((bi, p_i), (bj, p_j)):
-        if body is obstacle:  # rigid side: no dofs, its motion is prescribed (u_j_prescribed)
+    for body, p, loc in ((bi, p_i, locators[0]), (bj, p_j, locators[1])):
+        if loc is None:
             sides.append((np.zeros((len(p), 0), np.int32), np.zeros((len(p), 0))))
             continue
-        if cut is not None:  # structured grid: O(1) location by index
-            loc = GridLocator(scene.mesh, scene.cell_tags, body.tag, cut, degree)
-        else:
-            loc = BodyLocator(scene.mesh, scene.cell_tags, body.tag, scene.cell_type, degree)
         cells, X, outside = loc.locate(p, max_outside)
         if np.any(cells < 0):
             bad = np.flatnonzero(cells < 0)[0]

@@ -5,7 +5,9 @@ The loop (newton.augmented_loop) stops when no segment multiplier changes by mor
 the largest traction; the fixed point has zero mean gap on every active segment and no slip
 over the step at sticking ones, whatever eps0. So:
 - the patch test gives the exact pressure E' d / H = 0.010989011 (not the penalised one) to
-  1e-8 on both paths, any cut height, triangles, with friction, for eps0 from 1e-4 to 1e4;
+  1e-8 on both paths, any cut height, triangles, with friction, for eps0 from 1e-4 to 1e4, and
+  on non-matching meshes (5 and 7 upper cells on 8): the contact terms are integrated on
+  pieces of Gamma_c split at the multiplier elements' ends and at both meshes' cell edges;
 - Hertz gives the same p(x), a, p0 for eps0 = 1e-4 and 1e4 (asserted to 1e-5 relative: the
   loop's tolerance, amplified in p0 by the force control's secant iterations: 1.7e-6 seen), with no open point between active ones
   (the stiff penalty's checkerboard: one traction per segment of length h cannot alternate);
@@ -52,6 +54,10 @@ def points(out):
         ["--discretization", "cut", "--eps0", "1e-3"],
         ["--triangles"],
         ["--mu", "0.3"],
+        # non-matching meshes: exact only with the contact terms split at both meshes' edges
+        ["--upper-cells", "5"],
+        ["--upper-cells", "7", "--triangles"],
+        ["--discretization", "cut", "--interface", "0.5126"],
     ],
     ids=lambda a: " ".join(a),
 )

@@ -172,3 +172,28 @@ def test_bad_inputs():
         df.closest_point_projection(a, np.array([[0.5, 1.5]]))
     with pytest.raises(ValueError, match=r"\(n, 2\)"):
         df.closest_point_projection(a, np.zeros((3, 3)))
+
+
+def test_segment_quadrature_reproduces_and_refines_contact_surface():
+    """`segment_quadrature` on contact_surface's own segments gives its points, weights and
+    normals bitwise; on the segments split in two it integrates a cubic along Gamma_c as
+    exactly (2 Gauss points per piece) and the length is unchanged."""
+    A = df.Box([-3.0, -1.0], [3.0, 0.0])
+    B = df.Circle([0.0, 1.04], 1.0)
+    g = df.StructuredGrid.uniform([-1.0, -0.5], [1.0, 0.5], [64, 32])
+    pa, pb = df.levelset_from_shape(g, A), df.levelset_from_shape(g, B)
+    s = df.contact_surface(pa, pb, eps=0.08)
+    phi = df.intermediate_levelset(pa, pb)
+    q = df._cpp.segment_quadrature(phi, s["segments"], s["cells"], 2)
+    for k in ("points", "weights", "normals", "tangents", "segment"):
+        assert np.array_equal(q[k], s[k]), k
+    mid = 0.5 * (s["segments"][:, 0] + s["segments"][:, 1])
+    halves = np.concatenate(
+        [np.stack([s["segments"][:, 0], mid], 1), np.stack([mid, s["segments"][:, 1]], 1)]
+    )
+    r = df._cpp.segment_quadrature(phi, halves, np.r_[s["cells"], s["cells"]], 2)
+    f = lambda x: x[:, 0] ** 3 - 2 * x[:, 0] * x[:, 1]  # cubic in the arc parameter of a piece
+    assert abs(r["weights"].sum() - s["weights"].sum()) < 1e-13
+    assert abs(np.dot(r["weights"], f(r["points"])) - np.dot(s["weights"], f(s["points"]))) < 1e-13
+    with pytest.raises(ValueError, match="num_gauss"):
+        df._cpp.segment_quadrature(phi, s["segments"], s["cells"], 0)

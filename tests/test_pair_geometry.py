@@ -132,3 +132,38 @@ def test_near_box_leaves_the_contact_unchanged(hertz, monkeypatch):
     # the contact lies well inside the kept part, which is a fraction of the whole width
     x = fast.p_i[:, 0]
     assert np.ptp(x) < 0.5 * (whole[1, 0] - whole[0, 0])
+
+
+def test_split_segments_and_label_breaks():
+    """Pieces split where a label of their points changes (bisection), never into pieces
+    shorter than tol, and the ends of the multiplier elements along a chain."""
+    from dolfinx_forms.contact import label_breaks, multiplier_breaks, split_segments
+
+    pieces = np.array([[[0.0, 0.0], [1.0, 0.0]], [[2.0, 0.0], [1.0, 0.0]]])  # one chain, 2 pieces
+    cells = np.array([7, 8], np.int32)
+
+    def labels(x):  # cells of a mesh with edges at x = 0.3, 0.7, 1.6
+        return np.searchsorted([0.3, 0.7, 1.6], x[:, 0])[:, None]
+
+    segs = pieces
+    for _ in range(4):
+        k, t = label_breaks(segs, labels, 1e-10)
+        if len(k) == 0:
+            break
+        segs, cells = split_segments(segs, cells, k, t, 1e-10)
+    ends = np.sort(np.unique(np.round(segs[..., 0].ravel(), 12)))
+    assert np.allclose(ends, [0.0, 0.3, 0.7, 1.0, 1.6, 2.0], atol=1e-12)
+    assert set(cells.tolist()) == {7, 8}
+    # every piece has one label along it
+    mid = 0.5 * (segs[:, 0] + segs[:, 1])
+    assert np.array_equal(labels(segs[:, 0] * 0.999 + mid * 0.001), labels(mid))
+    # multiplier elements of length 0.5 on the chain of length 2: ends at 0.5, 1.0, 1.5 of the
+    # arc from the chain's start (x = 0 or 2); the piece [2, 1] is read from its first end
+    k, t = multiplier_breaks(pieces, 0.5, 1e-10)
+    x = pieces[k, 0, 0] + t * (pieces[k, 1, 0] - pieces[k, 0, 0])
+    assert np.allclose(np.sort(x), [0.5, 1.5])  # 1.0 is a piece end already
+    # cuts closer than tol to an end or to each other are skipped
+    s2, _ = split_segments(
+        pieces[:1], cells[:1], np.array([0, 0, 0]), np.array([1e-12, 0.5, 0.5 + 1e-13]), 1e-10
+    )
+    assert len(s2) == 2

@@ -74,6 +74,44 @@ void gauss_legendre(int n, std::vector<double>& x, std::vector<double>& w) {
     w[k] = 0.5 * q[n - 1][k];
   }
 }
+
+/// Segment [p, q] of Gamma_c in grid cell `cell` and its Gauss points (abscissae gx on [0, 1],
+/// weights gw), with unit normals grad phi_int / |grad phi_int| (body i -> j) appended to s
+void add_segment(const LevelSet& phi, std::int32_t cell, std::array<double, 2> p,
+                 std::array<double, 2> q, const std::vector<double>& gx,
+                 const std::vector<double>& gw, ContactSurface& s) {
+  const double h = phi.grid().min_spacing();
+  const double len = std::hypot(q[0] - p[0], q[1] - p[1]);
+  const std::int32_t seg = std::int32_t(s.cells.size());
+  s.segments.insert(s.segments.end(), {p[0], p[1], q[0], q[1]});
+  s.cells.push_back(cell);
+  // Unit normal of the segment, for the rare point where grad phi_int vanishes
+  const double sn[2] = {-(q[1] - p[1]) / len, (q[0] - p[0]) / len};
+  for (std::size_t k = 0; k < gx.size(); ++k) {
+    const double x[2] = {p[0] + gx[k] * (q[0] - p[0]), p[1] + gx[k] * (q[1] - p[1])};
+    double g[2];
+    phi.eval(std::span<const double, 2>(x, 2), std::span<double, 2>(g, 2));
+    const double gn = std::hypot(g[0], g[1]);
+    double n[2];
+    if (gn > 1e-12)
+      n[0] = g[0] / gn, n[1] = g[1] / gn;
+    else {
+      // Orient the segment normal towards increasing phi_int (body i -> body j)
+      const double xp[2] = {x[0] + 1e-3 * h * sn[0], x[1] + 1e-3 * h * sn[1]};
+      const double xm[2] = {x[0] - 1e-3 * h * sn[0], x[1] - 1e-3 * h * sn[1]};
+      const double sgn =
+          phi.eval(std::span<const double, 2>(xp, 2)) >= phi.eval(std::span<const double, 2>(xm, 2))
+              ? 1.0
+              : -1.0;
+      n[0] = sgn * sn[0], n[1] = sgn * sn[1];
+    }
+    s.points.insert(s.points.end(), {x[0], x[1]});
+    s.weights.push_back(gw[k] * len);
+    s.normals.insert(s.normals.end(), {n[0], n[1]});
+    s.tangents.insert(s.tangents.end(), {-n[1], n[0]});
+    s.segment.push_back(seg);
+  }
+}
 } // namespace
 
 LevelSet contact::min_levelset(const LevelSet& phi_i, const LevelSet& phi_j) {
@@ -188,33 +226,26 @@ ContactSurface contact::contact_surface(const LevelSet& phi_i, const LevelSet& p
         const double len = std::hypot(q[0] - p[0], q[1] - p[1]);
         if (len <= 1e-12 * h)
           continue;
-        const std::int32_t seg = std::int32_t(s.cells.size());
-        s.segments.insert(s.segments.end(), {p[0], p[1], q[0], q[1]});
-        s.cells.push_back(std::int32_t(grid.cell(i, j)));
-        // Unit normal of the segment, for the rare point where grad phi_int vanishes
-        double sn[2] = {-(q[1] - p[1]) / len, (q[0] - p[0]) / len};
-        for (int k = 0; k < num_gauss; ++k) {
-          const double x[2] = {p[0] + gx[k] * (q[0] - p[0]), p[1] + gx[k] * (q[1] - p[1])};
-          double g[2];
-          phi.eval(std::span<const double, 2>(x, 2), std::span<double, 2>(g, 2));
-          double gn = std::hypot(g[0], g[1]);
-          double n[2];
-          if (gn > 1e-12)
-            n[0] = g[0] / gn, n[1] = g[1] / gn;
-          else {
-            // Orient the segment normal towards increasing phi_int (body i -> body j)
-            const double xp[2] = {x[0] + 1e-3 * h * sn[0], x[1] + 1e-3 * h * sn[1]};
-            const double xm[2] = {x[0] - 1e-3 * h * sn[0], x[1] - 1e-3 * h * sn[1]};
-            const double sgn = phi_at({xp[0], xp[1]}) >= phi_at({xm[0], xm[1]}) ? 1.0 : -1.0;
-            n[0] = sgn * sn[0], n[1] = sgn * sn[1];
-          }
-          s.points.insert(s.points.end(), {x[0], x[1]});
-          s.weights.push_back(gw[k] * len);
-          s.normals.insert(s.normals.end(), {n[0], n[1]});
-          s.tangents.insert(s.tangents.end(), {-n[1], n[0]});
-          s.segment.push_back(seg);
-        }
+        add_segment(phi, grid.cell(i, j), p, q, gx, gw, s);
       }
     }
+  return s;
+}
+
+ContactSurface contact::segment_quadrature(const LevelSet& phi_int,
+                                           std::span<const double> segments,
+                                           std::span<const std::int32_t> cells, int num_gauss) {
+  if (num_gauss < 1 or num_gauss > 5)
+    throw std::invalid_argument("segment_quadrature: num_gauss must be in 1..5, got " +
+                                std::to_string(num_gauss));
+  if (segments.size() != 4 * cells.size())
+    throw std::invalid_argument("segment_quadrature: segments must be (ns, 2, 2) for ns cells");
+  std::vector<double> gx, gw;
+  gauss_legendre(num_gauss, gx, gw);
+  ContactSurface s;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const double* e = segments.data() + 4 * k;
+    add_segment(phi_int, cells[k], {e[0], e[1]}, {e[2], e[3]}, gx, gw, s);
+  }
   return s;
 }

@@ -4,6 +4,7 @@
 #include "levelset.h"
 #include <algorithm>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace contact {
@@ -76,5 +77,18 @@ struct ContactSurface {
 /// @param[in] num_gauss Gauss points per segment (1..5)
 ContactSurface contact_surface(const LevelSet& phi_i, const LevelSet& phi_j, double eps,
                                int num_gauss = 2);
+
+/// @brief Quadrature of given segments of Gamma_c (eq 24): `num_gauss` Gauss-Legendre points
+/// per segment with the normals of `contact_surface` (unit grad phi_int, body i -> j).
+///
+/// `contact_surface` builds its segments with it; callers use it on segments split further,
+/// e.g. where a closest point crosses into another cell of a body or at the ends of the
+/// multiplier elements, so that each segment integrates smooth integrands.
+/// @param[in] phi_int Intermediate level set (`intermediate_levelset`)
+/// @param[in] segments (ns, 2, 2) end points
+/// @param[in] cells (ns,) grid cell of each segment (carried, not used)
+/// @param[in] num_gauss Gauss points per segment (1..5)
+ContactSurface segment_quadrature(const LevelSet& phi_int, std::span<const double> segments,
+                                  std::span<const std::int32_t> cells, int num_gauss = 2);
 
 } // namespace contact

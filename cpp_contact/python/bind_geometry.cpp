@@ -36,6 +36,23 @@ py::dict projection_dict(contact::ProjectionResult&& r) {
 }
 } // namespace
 
+namespace {
+/// A ContactSurface as a dict of numpy arrays (segments, cells, points, weights, normals,
+/// tangents, segment)
+py::dict surface_dict(ContactSurface&& s) {
+  const auto ns = py::ssize_t(s.cells.size()), nq = py::ssize_t(s.weights.size());
+  py::dict d;
+  d["segments"] = to_numpy(std::move(s.segments), {ns, 2, 2});
+  d["cells"] = to_numpy(std::move(s.cells), {ns});
+  d["points"] = to_numpy(std::move(s.points), {nq, 2});
+  d["weights"] = to_numpy(std::move(s.weights), {nq});
+  d["normals"] = to_numpy(std::move(s.normals), {nq, 2});
+  d["tangents"] = to_numpy(std::move(s.tangents), {nq, 2});
+  d["segment"] = to_numpy(std::move(s.segment), {nq});
+  return d;
+}
+} // namespace
+
 void bind_geometry(py::module_& m) {
   py::class_<StructuredGrid>(m, "StructuredGrid",
                              "Tensor-product 2D grid, uniform or graded; nodes x-fastest")
@@ -227,18 +244,20 @@ void bind_geometry(py::module_& m) {
       "contact_surface",
       [](const LevelSet& a, const LevelSet& b, double eps, int num_gauss) {
         ContactSurface s = contact_surface(a, b, eps, num_gauss);
-        const auto ns = py::ssize_t(s.cells.size()), nq = py::ssize_t(s.weights.size());
-        py::dict d;
-        d["segments"] = to_numpy(std::move(s.segments), {ns, 2, 2});
-        d["cells"] = to_numpy(std::move(s.cells), {ns});
-        d["points"] = to_numpy(std::move(s.points), {nq, 2});
-        d["weights"] = to_numpy(std::move(s.weights), {nq});
-        d["normals"] = to_numpy(std::move(s.normals), {nq, 2});
-        d["tangents"] = to_numpy(std::move(s.tangents), {nq, 2});
-        d["segment"] = to_numpy(std::move(s.segment), {nq});
-        return d;
+        return surface_dict(std::move(s));
       },
       py::arg("phi_i"), py::arg("phi_j"), py::arg("eps"), py::arg("num_gauss") = 2,
       "Gamma_c (eq 24): segments of phi_int = 0 in the contact region with Gauss points, weights, "
       "normals (body i -> j) and tangents");
+  m.def(
+      "segment_quadrature",
+      [](const LevelSet& phi_int, const py::array_t<double, py::array::c_style>& segments,
+         const py::array_t<std::int32_t, py::array::c_style>& cells, int num_gauss) {
+        ContactSurface s = segment_quadrature(
+            phi_int, std::span<const double>(segments.data(), std::size_t(segments.size())),
+            std::span<const std::int32_t>(cells.data(), std::size_t(cells.size())), num_gauss);
+        return surface_dict(std::move(s));
+      },
+      py::arg("phi_int"), py::arg("segments"), py::arg("cells"), py::arg("num_gauss") = 2,
+      "Gauss points, weights, normals and tangents on given segments of Gamma_c (eq 24)");
 }
