@@ -119,47 +119,53 @@ def multiplier_breaks(pieces, length, tol):
     n = round(L / length) equal elements) that fall inside the (m, 2, 2) `pieces`: (piece,
     parameter t in (0, 1) from the piece's first end) pairs, for `split_segments`."""
     arc, start, chain_of, lengths = chain_arcs(pieces, tol)
-    n_el = np.round(lengths / length).astype(np.int64)
-    piece, t = [], []
-    for k in range(len(pieces)):
-        n, L = n_el[chain_of[k]], lengths[chain_of[k]]
-        if n < 2:
-            continue
-        a, b = pieces[k]
-        length_k = np.linalg.norm(b - a)
-        ends = np.arange(1, n) * (L / n) - arc[k]  # element ends, from the piece's start
-        ends = ends[(ends > tol) & (ends < length_k - tol)] / length_k
-        forward = np.allclose(start[k], a, atol=tol, rtol=0)
-        piece += [k] * len(ends)
-        t += list(ends if forward else 1.0 - ends)
-    return np.array(piece, np.int64), np.array(t)
+    n_el = np.round(lengths / length).astype(np.int64)[chain_of]
+    el = lengths[chain_of] / np.maximum(n_el, 1)  # element length of each piece's chain
+    size = np.linalg.norm(pieces[:, 1] - pieces[:, 0], axis=1)
+    first = np.floor((arc + tol) / el).astype(np.int64) + 1  # element ends strictly inside
+    last = np.ceil((arc + size - tol) / el).astype(np.int64) - 1
+    last = np.minimum(last, n_el - 1)  # no end past the chain's (nor any for one element)
+    count = np.maximum(last - first + 1, 0)
+    piece = np.repeat(np.arange(len(pieces)), count)
+    j = first[piece] + np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+    t = (j * el[piece] - arc[piece]) / size[piece]
+    forward = np.linalg.norm(start - pieces[:, 0], axis=1) <= tol
+    return piece, np.where(forward[piece], t, 1.0 - t)
 
 
 def split_segments(pieces, cells, piece, t, tol):
     """(m, 2, 2) pieces (and their grid cells) cut at the parameters t of `piece`: the pieces
     in order, each split into its sub-pieces. Cuts closer than tol (a length) to an end or to
-    another cut are skipped: no sub-piece is shorter than tol (its ends would join no chain)."""
+    the cut before are skipped: no sub-piece is shorter than tol (its ends would join no
+    chain)."""
+    m = len(pieces)
+    step = tol / np.maximum(np.linalg.norm(pieces[:, 1] - pieces[:, 0], axis=1), 1e-300)
     order = np.lexsort((t, piece))
     piece, t = piece[order], t[order]
-    out, out_cells = [], []
-    for k in range(len(pieces)):
-        a, b = pieces[k]
-        step = tol / max(np.linalg.norm(b - a), 1e-300)
-        tk = [0.0]
-        for c in t[np.searchsorted(piece, k) : np.searchsorted(piece, k, "right")]:
-            if c - tk[-1] > step and c < 1.0 - step:
-                tk.append(c)
-        tk = np.array(tk + [1.0])
-        x = a + tk[:, None] * (b - a)
-        out.append(np.stack([x[:-1], x[1:]], axis=1))
-        out_cells.append(np.full(len(tk) - 1, cells[k], np.int32))
-    return np.concatenate(out), np.concatenate(out_cells)
+    keep = (t > step[piece]) & (t < 1.0 - step[piece])
+    piece, t = piece[keep], t[keep]
+    close = np.zeros(len(piece), bool)
+    close[1:] = (piece[1:] == piece[:-1]) & (np.diff(t) <= step[piece[1:]])
+    piece, t = piece[~close], t[~close]
+    key = np.r_[np.arange(m), piece, np.arange(m)]
+    ts = np.r_[np.zeros(m), t, np.ones(m)]
+    order = np.lexsort((ts, key))
+    key, ts = key[order], ts[order]
+    pair = np.flatnonzero(key[1:] == key[:-1])  # consecutive parameters of one piece
+    k, t0, t1 = key[pair], ts[pair], ts[pair + 1]
+    a, b = pieces[k, 0], pieces[k, 1]
+    # ends shared by two sub-pieces are one number (t1 of one is t0 of the next), the pieces'
+    # own ends are kept bitwise: the chains join
+    x0 = np.where((t0 == 0.0)[:, None], a, a + t0[:, None] * (b - a))
+    x1 = np.where((t1 == 1.0)[:, None], b, a + t1[:, None] * (b - a))
+    return np.stack([x0, x1], axis=1), cells[k].astype(np.int32)
 
 
-def label_breaks(pieces, labels, tol, iterations=48):
+def label_breaks(pieces, labels, tol, iterations=36):
     """Where the integer labels of the points of the (m, 2, 2) `pieces` change along them
     (`labels(points)` -> (n, k), e.g. the cells that hold the closest points on each body):
-    the first change along each piece, by bisection to 2^-iterations of it. Labels are read
+    the first change along each piece, by bisection to 2^-iterations of it (below tol for
+    pieces up to ~6 h / grid_refine long at tol = 1e-10 dx). Labels are read
     tol (a length: `split_segments` makes no piece shorter) inside the ends, so a change
     closer to an end is ignored. One change per piece and round: call it again on the split
     pieces for more. Returns (piece, t) pairs for `split_segments`."""
@@ -332,6 +338,10 @@ class BodyLocator:
         r = self.locator.locate(np.ascontiguousarray(points), max_distance)
         return r["cells"], r["X"], r["outside"]
 
+    def cell_label(self, points, max_distance):
+        """An integer per point that changes wherever its cell does (here: the cell)."""
+        return self.locate(points, max_distance)[0]
+
     def basis(self, X):
         return self.element.tabulate(0, X)[0, :, :, 0]
 
@@ -365,6 +375,12 @@ class GridLocator:
         i = np.clip(np.searchsorted(self.xl, p[:, 0], side="right") - 1, 0, len(self.xl) - 2)
         j = np.clip(np.searchsorted(self.yl, p[:, 1], side="right") - 1, 0, len(self.yl) - 2)
         return i, j
+
+    def cell_label(self, points, max_distance):
+        """An integer per point that changes wherever its cell does: its grid cell's index (a
+        point in an inactive grid cell goes to a neighbour's cell, inside that grid cell)."""
+        i, j = self._index(np.asarray(points, float)[:, :2])
+        return i * self.table.shape[1] + j
 
     def locate(self, points, max_distance):
         p = np.asarray(points, float)[:, :2]
@@ -525,7 +541,7 @@ def pair_geometry(
             # exact shapes' gradients by differences of 1e-7 scale: fine enough near corners
             proj = [pr["points"] for pr in project(points, 1e-3 * h)]
             cells = [
-                np.zeros(len(points), np.int32) if loc is None else loc.locate(p, max_outside)[0]
+                np.zeros(len(points), np.int32) if loc is None else loc.cell_label(p, max_outside)
                 for loc, p in zip(locators, proj)
             ]
             past = [beyond_end(points, p, n, 1e-9 * dx) for p in proj]
