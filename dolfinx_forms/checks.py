@@ -12,7 +12,11 @@ them) and returns, on every rank, one line per failed check:
   stiff point-wise penalty; the augmented enforcement's segments do not do this). Separate
   contact spots of one pair (rough grains) are further apart than h, or are one gap.
 
-The demos put them in metrics.json (`solver.warnings`) and on the console.
+The demos put them in metrics.json (`solver.warnings`) and on the console, with the largest
+penetration (`penetration`): point-wise, and as the law points' weighted mean gap, which is
+what the augmented enforcement's multipliers constrain (a mortar method's weak
+non-penetration: its fixed point has zero mean gap at every active node, the point-wise gap
+between nodes is the P1 trace's discretisation error).
 """
 
 import numpy as np
@@ -72,3 +76,22 @@ def contact_warnings(problem):
         if s is not None:
             mine += pair_warnings(g, s, problem.scene.h_contact, problem.band, "-".join(names[k]))
     return [w for part in problem.comm.allgather(mine) for w in part]
+
+
+def penetration(problem):
+    """Largest penetration over every pair's active points (`points`) and active law points
+    (`law_points`: their weighted mean gaps), in units of h_contact; 0 without contact. The
+    same on every rank."""
+    from mpi4py import MPI
+
+    pts = law = 0.0
+    for s in problem.contact.committed:
+        if s is None:
+            continue
+        if np.any(s["state"] > 0):
+            pts = max(pts, -float(s["g_n"][s["state"] > 0].min()))
+        if np.any(s["law_state"] > 0):
+            law = max(law, -float(s["law_g_n"][s["law_state"] > 0].min()))
+    h = problem.scene.h_contact
+    pts, law = (problem.comm.allreduce(max(v, 0.0), op=MPI.MAX) for v in (pts, law))
+    return {"points": pts / h, "law_points": law / h}

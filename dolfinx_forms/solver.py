@@ -315,10 +315,11 @@ class ContactProblem:
 def solver_metrics(problem, converged=True):
     """The `solver` block of metrics.json, with the failed checks of the final state
     (`checks.contact_warnings`) in `warnings`."""
-    from .checks import contact_warnings
+    from .checks import contact_warnings, penetration
 
     return {
         "warnings": contact_warnings(problem),
+        "penetration_h": penetration(problem),
         "load_steps": len(problem.steps),
         "newton_iterations": [s.iterations for s in problem.steps],
         "converged": bool(converged),

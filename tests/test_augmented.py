@@ -79,6 +79,9 @@ def test_hertz_independent_of_eps0(tmp_path, disc):
     for key in ("pressure_rel_l2_error", "contact_half_width", "peak_pressure"):
         a, b = (r["results"][key] for r in runs)
         assert abs(a - b) <= 1e-5 * abs(a), key
+    for r in runs:  # the multipliers' constraint: zero weighted mean gap at every active node
+        assert r["solver"]["penetration_h"]["law_points"] < 1e-6
+        assert r["solver"]["penetration_h"]["points"] < 0.05  # the P1 trace between nodes
     for e in ("1e-4", "1e4"):
         pts = points(tmp_path / e)
         active = np.flatnonzero(pts["state"] != "open")
