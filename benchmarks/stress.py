@@ -10,7 +10,9 @@ Cases (Hertz: R = 10, E = 1e4, P = 430 at h = a/20 unless said):
 * the patch test on matching and non-matching (5-on-8, 7-on-8) meshes.
 Columns: the case, exit status, p(x) L2 error (or the patch pressure's deviation from the
 exact E' d / H), contact half-width a against Hertz, the open points between two active ones
-shorter than h (checkerboard, `checks.short_gaps`), the largest penetration / h, the solver warnings, Newton iterations,
+shorter than h (checkerboard, `checks.short_gaps`), the largest penetration / h (point-wise,
+and of the law points' weighted mean gaps: metrics.json solver.penetration_h), the solver
+warnings, Newton iterations,
 augmentations, wall time. Writes benchmarks/results/stress.{csv,md,png}.
 
 Run: /usr/bin/python3 benchmarks/stress.py [--quick] [--only eps0,mu,load,patch]
@@ -131,6 +133,9 @@ def run(case, timeout):
             if c_h:
                 row["stick_rel_error"] = None if c is None else abs(c - c_h) / c_h
         row["checkerboard"], row["penetration_over_h"] = zone_checks(out, h)
+        # the weighted mean gap of the active law points (augmented: what the multipliers
+        # constrain; penalty: the points themselves)
+        row["law_penetration_over_h"] = s.get("penetration_h", {}).get("law_points")
         row["warnings"] = len(s.get("warnings", []))
         row["newton"] = sum(s["newton_iterations"])
         row["augmentations"] = sum(s.get("augmentations", []))
@@ -169,6 +174,7 @@ def main():
         "stick_rel_error",
         "checkerboard",
         "penetration_over_h",
+        "law_penetration_over_h",
         "warnings",
         "newton",
         "augmentations",

@@ -227,7 +227,7 @@ def multiplier_nodes(surface, kind, length, tol):
     reached = np.zeros(int(n_nodes.sum()), bool)
     reached[nodes[weights > 0]] = True
     new = np.cumsum(reached) - 1
-    weights[nodes >= 0] = np.where(reached[nodes[nodes >= 0]], weights[nodes >= 0], tol)
+    weights[nodes >= 0] = np.where(reached[nodes[nodes >= 0]], weights[nodes >= 0], 0.0)
     nodes = np.where((nodes >= 0) & (weights > 0), new[np.maximum(nodes, 0)], -1).astype(np.int32)
     swap = nodes[:, 0] < 0  # the first node must exist
     nodes[swap] = nodes[swap][:, ::-1]
