@@ -167,3 +167,15 @@ def test_split_segments_and_label_breaks():
         pieces[:1], cells[:1], np.array([0, 0, 0]), np.array([1e-12, 0.5, 0.5 + 1e-13]), 1e-10
     )
     assert len(s2) == 2
+
+
+def test_beyond_end_flags_points_past_a_corner_only():
+    """Gamma_c along y = 0, a body ending at x = 0 (its corner): past the corner the offset to
+    the closest point runs along Gamma_c; inside the face's shadow it is across (a gap), also
+    tilted by a curved partner's normal (up to 45 degrees)."""
+    from dolfinx_forms.contact import beyond_end
+
+    n = np.tile([0.0, 1.0], (5, 1))
+    pts = np.array([[-0.3, 0.0], [-1e-9, 0.0], [0.2, 0.0], [0.5, 0.01], [0.7, 0.0]])
+    closest = np.array([[0.0, 0.0], [0.0, 0.0], [0.2, -0.05], [0.49, 0.0], [0.7, 0.0]])
+    assert beyond_end(pts, closest, n, 1e-12).tolist() == [True, True, False, False, False]

@@ -171,6 +171,42 @@ TEST(ContactRegion, TouchingBodiesKeepTheirContactLine) {
   }
 }
 
+TEST(ContactSurface, SegmentQuadratureIsTheSurfacesOwnAndSplitsExactly) {
+  // segment_quadrature on contact_surface's segments gives its points, weights and normals;
+  // each segment split in three integrates x^3 along the flat Gamma_c as exactly
+  const StructuredGrid g = StructuredGrid::uniform({-0.5, -0.5}, {0.5, 0.5}, {20, 20});
+  const LevelSet a = levelset_from_shape(g, Box({-1, -1}, {1, 0.013}));
+  const LevelSet b = levelset_from_shape(g, Box({-1, 0.013}, {1, 1}));
+  const ContactSurface s = contact_surface(a, b, 0.05, 2);
+  const LevelSet phi = intermediate_levelset(a, b);
+  const ContactSurface q = segment_quadrature(phi, s.segments, s.cells, 2);
+  EXPECT_EQ(q.points, s.points);
+  EXPECT_EQ(q.weights, s.weights);
+  EXPECT_EQ(q.normals, s.normals);
+  std::vector<double> thirds;
+  std::vector<std::int32_t> cells;
+  for (std::size_t k = 0; k < s.cells.size(); ++k) {
+    const double* e = s.segments.data() + 4 * k;
+    for (int i = 0; i < 3; ++i)
+      for (double t : {i / 3.0, (i + 1) / 3.0})
+        thirds.insert(thirds.end(), {e[0] + t * (e[2] - e[0]), e[1] + t * (e[3] - e[1])});
+    cells.insert(cells.end(), 3, s.cells[k]);
+  }
+  const ContactSurface r = segment_quadrature(phi, thirds, cells, 2);
+  ASSERT_EQ(r.weights.size(), 3 * s.weights.size());
+  auto cubic = [](const ContactSurface& c) {
+    double sum = 0;
+    for (std::size_t p = 0; p < c.weights.size(); ++p)
+      sum += c.weights[p] * std::pow(c.points[2 * p], 3);
+    return sum;
+  };
+  EXPECT_NEAR(cubic(r), cubic(s), 1e-14);
+  for (std::size_t p = 0; p < r.weights.size(); ++p)
+    EXPECT_NEAR(r.normals[2 * p + 1], 1.0, 1e-12); // body i (below) -> j
+  EXPECT_THROW(segment_quadrature(phi, s.segments, s.cells, 6), std::invalid_argument);
+  EXPECT_THROW(segment_quadrature(phi, thirds, s.cells, 2), std::invalid_argument);
+}
+
 TEST(Gaps, PointGapsOwnEqs26To30) {
   const double p_i[2] = {1.0, 2.0}, p_j[2] = {1.25, 2.5}, n[2] = {0.0, 1.0}, t[2] = {-1.0, 0.0};
   const double g0 = initial_normal_gap(p_i, p_j, n);
