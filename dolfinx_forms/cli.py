@@ -363,6 +363,7 @@ def demo_parser(prog, doc, out, options=(), discretization=True, petsc=True, cel
         add_cells(p, *cells)
     if petsc:
         add_enforcement(p)
+        add_linear_solver(p)
         add_petsc(p)
     return p
 
@@ -392,6 +393,18 @@ def add_enforcement(parser):
         help="contact enforcement: penalty (the answer depends on --eps0) or augmented "
         "(augmented Lagrangian with one pressure per contact segment: --eps0 sets only the "
         "speed)",
+    )
+
+
+def add_linear_solver(parser):
+    """--linear-solver: Newton's linear solver (dolfinx_forms/linear.py)."""
+    parser.add_argument(
+        "--linear-solver",
+        choices=["auto", "condensed", "factorised", "iterative"],
+        default="auto",
+        help="Newton's linear solver: auto (by the problem), condensed (the bulk factorised "
+        "once, Schur complement on the contact dofs), factorised (MUMPS LU per changed J) or "
+        "iterative (CG/GMRES + GAMG with the rigid-body modes; --petsc options apply)",
     )
 
 
