@@ -75,7 +75,12 @@ class DemoParser(argparse.ArgumentParser):
         if getattr(self, "_discretization", False):  # add_discretization
             check_discretization(self, a)
         if getattr(self, "_petsc_dest", None) is not None:  # add_petsc: KEY=VALUE -> dict
-            setattr(a, self._petsc_dest, petsc_options(self, getattr(a, self._petsc_dest)))
+            # the trial solve reads the options on top of the chosen solver's defaults
+            defaults = (
+                ITERATIVE_DEFAULTS if getattr(a, "linear_solver", "") == "iterative" else None
+            )
+            opts = petsc_options(self, getattr(a, self._petsc_dest), defaults)
+            setattr(a, self._petsc_dest, opts)
         if getattr(a, "verbose", False):
             set_verbose(True)
         if self._out_dest is not None:
@@ -178,9 +183,11 @@ def add_petsc(parser):
     parser._petsc_dest = "petsc"
 
 
-def petsc_options(parser, items):
+def petsc_options(parser, items, defaults=None):
     """Parse repeated --petsc KEY=VALUE into a dict (keys without the leading dash); a dict
-    (already parsed, see add_petsc) is returned as it is."""
+    (already parsed, see add_petsc) is returned as it is. defaults: the solver's options that
+    they override in the trial solve (default SOLVER_DEFAULTS)."""
+    defaults = SOLVER_DEFAULTS if defaults is None else defaults
     if isinstance(items, dict):
         return items
     opts = {}
@@ -200,8 +207,8 @@ def petsc_options(parser, items):
                 "or a value of the wrong kind)"
             )
     if opts:
-        ierr, unread = petsc_trial(opts)
-        every = {**SOLVER_DEFAULTS, **opts}
+        ierr, unread = petsc_trial(opts, defaults)
+        every = {**defaults, **opts}
         given = ", ".join(f"{k}={v}" for k, v in opts.items())
         if ierr is not None:
             parser.error(
@@ -244,6 +251,8 @@ def petsc_refuses(opts):
 # the linear solver's own options (dolfinx_forms/linear.py DEFAULT_OPTIONS), which --petsc
 # overrides: the trial solve reads the user's options on top of them, as the solver does
 SOLVER_DEFAULTS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+# --linear-solver iterative (linear.Iterative: CG + GAMG, its GAMG options in ITERATIVE_OPTIONS)
+ITERATIVE_DEFAULTS = {"ksp_type": "cg", "pc_type": "gamg"}
 
 
 def _petsc_used():
@@ -298,8 +307,9 @@ def _trial_matrix(PETSc, n=12):
     return A
 
 
-def petsc_trial(opts):
-    """Solve a small system with the solver's defaults overridden by `opts` (scratch prefix,
+def petsc_trial(opts, defaults=None):
+    """Solve a small system with the solver's defaults (SOLVER_DEFAULTS unless given)
+    overridden by `opts` (scratch prefix,
     COMM_SELF, removed after; anything PETSc prints, e.g. ksp_view, is discarded). Returns
     (PETSc's error code or None, the keys of `opts` PETSc never read, in their order)."""
     import ctypes
@@ -308,7 +318,7 @@ def petsc_trial(opts):
     from petsc4py import PETSc
 
     o, prefix = PETSc.Options(), "ils_check_"
-    every = {**SOLVER_DEFAULTS, **opts}
+    every = {**(SOLVER_DEFAULTS if defaults is None else defaults), **opts}
     for k, v in every.items():
         o[prefix + k] = v
     A = _trial_matrix(PETSc)

@@ -1,0 +1,272 @@
+#!/usr/bin/python3
+"""The iterative linear solver (CG + GAMG with the rigid-body modes, dolfinx_forms.linear.
+Iterative) against the direct ones on Hertz, and its iteration counts against the smallest cut
+fraction (issue 12, item 5).
+
+Table "hertz": per path (conforming, cut) and mesh divisor (h = a/divisor, the demo's scene
+otherwise), one subprocess per solver runs demos/hertz.py's scene, problem and stages
+(frictionless, force control): "direct" is today's choice (the condensed bulk, else a MUMPS
+LU per changed J), "iterative" the AMG solver. Recorded: dofs, Newton iterations, AMG set-ups,
+Krylov iterations per solve (mean, max), solve-phase and total time (without meshing), peak
+resident memory, p(x) error and reaction P, and for the iterative run the differences to the
+direct one: |u - u_direct|_max / |u_direct|_max, the p(x) error and P.
+
+Table "cuts": the contact patch test of benchmarks/small_cuts.py (`patch_cut_scene`, the
+interface at y = (k + eta) h so that the lower body's top row has inside fraction eta) on an
+n x n grid, solved with linear_solver="iterative", for eta = 0.5 ... 1e-8, ghost penalty
+gamma in {0, 0.01 (default), 0.1}, the patch test's penalty eps0 = 1e-3 and Hertz's 0.5, and
+two GAMG set-ups: "tuned" (linear.ITERATIVE_OPTIONS) and "petsc" (PETSc's GAMG defaults with
+the same near-null space). Recorded: Krylov iterations per solve (max, mean), Newton
+iterations, failure.
+
+Writes (atomically) <out-dir>/amg.json, amg_hertz.csv, amg_cuts.csv and amg.png.
+Usage: /usr/bin/python3 benchmarks/amg.py [--divisors 20,40,80,160] [--paths conforming,cut]
+           [--n 60] [--quick] [--out-dir benchmarks/results] [--timeout 900] [--skip-hertz]
+Timings on a shared machine are noisy: compare the ratios of one run.
+"""
+
+import argparse
+import csv
+import io
+import json
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+from scaling import _hertz_demo, child, write_atomic  # noqa: E402
+
+ETAS = (0.5, 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
+GAMMAS = (0.0, 0.01, 0.1)
+EPS0S = (1e-3, 0.5)
+# PETSc's GAMG defaults (3.18), to set against linear.ITERATIVE_OPTIONS
+PETSC_GAMG = {
+    "pc_gamg_threshold": "0",
+    "pc_gamg_use_sa_esteig": "1",
+    "mg_levels_ksp_chebyshev_esteig_steps": "10",
+}
+
+
+# --------------------------------------------------------------------------- hertz
+def hertz_child(path, divisor, solver, npy):
+    """One Hertz run in this process; prints a JSON record, saves u to npy."""
+    from dolfinx_forms.demo import compute
+
+    hertz = _hertz_demo()
+    kinds = ["condensed", "factorised"] if solver == "direct" else [solver]
+    for kind in kinds:
+        p = vars(hertz.parse(["--discretization", path, "--linear-solver", kind]))
+        p["h"] = hertz.estimate(p)[1] / divisor
+        try:
+            run = compute(
+                "hertz", p, hertz.scene, hertz.problem, hertz.stages, hertz.evaluate,
+                reactions=["block_bottom"],
+            )  # fmt: skip
+            break
+        except ValueError as e:  # condensed does not apply: a full factorisation
+            if "does not apply" not in str(e):
+                raise
+    pb, m = run.problem, run.metrics
+    np.save(npy, pb.u.x.array)
+    its = list(getattr(pb.linear, "iterations", []))
+    t = m["timing_s"]
+    print(
+        json.dumps(
+            dict(
+                path=path,
+                divisor=divisor,
+                solver=solver,
+                linear_solver=pb.linear.name,
+                dofs=pb.num_dofs,
+                newton=sum(m["solver"]["newton_iterations"]),
+                setups=int(pb.factorisations),
+                solves=len(its),
+                its_mean=float(np.mean(its)) if its else None,
+                its_max=max(its) if its else None,
+                iterations=its,
+                t_solve=t["solve"],
+                t_run=t["total"] - t["mesh"],
+                pressure_error=m["results"]["pressure_rel_l2_error"],
+                P=abs(m["results"]["reaction"][1]),
+            )
+        )
+    )
+
+
+def hertz_table(paths, divisors, timeout, tmp):
+    rows = []
+    for d in divisors:
+        for path in paths:
+            recs = {}
+            for solver in ("direct", "iterative"):
+                npy = Path(tmp) / f"u_{path}_{d}_{solver}.npy"
+                cmd = [str(Path(__file__)), "--child", path, str(d), solver, str(npy)]
+                rc, so, se, wall, rss = child(cmd, timeout)
+                if rc:
+                    r = dict(path=path, divisor=d, solver=solver, error=se.strip()[-300:])
+                else:
+                    r = json.loads(so.strip().splitlines()[-1])
+                    r.update(wall=wall, peak_rss_mb=rss)
+                recs[solver] = r
+            di, it = recs["direct"], recs["iterative"]
+            if "error" not in di and "error" not in it:
+                ud, ui = np.load(Path(tmp) / f"u_{path}_{d}_direct.npy"), None
+                ui = np.load(Path(tmp) / f"u_{path}_{d}_iterative.npy")
+                it.update(
+                    u_rel_diff=float(np.abs(ui - ud).max() / np.abs(ud).max()),
+                    pressure_error_diff=abs(it["pressure_error"] - di["pressure_error"]),
+                    P_rel_diff=abs(it["P"] / di["P"] - 1),
+                    time_ratio=it["t_run"] / di["t_run"],
+                    solve_ratio=it["t_solve"] / di["t_solve"],
+                )
+            for r in (di, it):
+                rows.append(r)
+                print(json.dumps({k: v for k, v in r.items() if k != "iterations"}), flush=True)
+    return rows
+
+
+# --------------------------------------------------------------------------- cuts
+def cuts_table(n, etas, gammas, eps0s):
+    from small_cuts import interface_height, patch_problem
+
+    from dolfinx_forms.newton import ContactSolverError
+
+    rows = []
+    for eps0 in eps0s:
+        for gamma in gammas:
+            for setup, opts in (("tuned", None), ("petsc", PETSC_GAMG)):
+                for eta in etas:
+                    t0 = time.perf_counter()
+                    sc, pb = _patch(patch_problem, n, interface_height(n, eta), gamma, eps0, opts)
+                    failed = ""
+                    try:
+                        pb.solve()
+                    except ContactSolverError as e:
+                        failed = str(e).splitlines()[0][:200]
+                    its = pb.linear.iterations
+                    r = dict(
+                        n=n,
+                        dofs=pb.num_dofs,
+                        eps0=eps0,
+                        gamma=gamma,
+                        gamg=setup,
+                        eta=eta,
+                        its_max=max(its) if its else None,
+                        its_mean=float(np.mean(its)) if its else None,
+                        solves=len(its),
+                        setups=pb.linear.setups,
+                        newton=sum(s.iterations for s in pb.steps),
+                        failed=failed,
+                        time_s=time.perf_counter() - t0,
+                    )
+                    rows.append(r)
+                    print(json.dumps(r), flush=True)
+    return rows
+
+
+def _patch(patch_problem, n, interface, gamma, eps0, petsc_options):
+    """small_cuts.patch_problem with the iterative solver (and petsc_options)."""
+    from dolfinx_forms import solver
+
+    orig = solver.ContactProblem
+
+    def iterative(*a, **kw):
+        return orig(*a, **kw, linear_solver="iterative", petsc_options=petsc_options)
+
+    import small_cuts
+
+    small_cuts.ContactProblem = iterative
+    try:
+        return patch_problem(n, interface, gamma, eps0=eps0)
+    finally:
+        small_cuts.ContactProblem = orig
+
+
+# --------------------------------------------------------------------------- output
+def write_csv(rows, path):
+    keys = list(dict.fromkeys(k for r in rows for k in r if k != "iterations"))
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=keys, extrasaction="ignore")
+    w.writeheader()
+    w.writerows(rows)
+    write_atomic(path, buf.getvalue())
+
+
+def plot(hertz, cuts, path):
+    import os
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    for p, mk in (("conforming", "o"), ("cut", "s")):
+        rr = [r for r in hertz if r.get("path") == p and r.get("solver") == "iterative"]
+        rr = [r for r in rr if "dofs" in r]
+        if rr:
+            n = [r["dofs"] for r in rr]
+            ax[0].loglog(n, [r["its_max"] for r in rr], mk + "-", label=f"{p}: max")
+            ax[0].loglog(n, [r["its_mean"] for r in rr], mk + "--", label=f"{p}: mean")
+            rr = [r for r in rr if "time_ratio" in r]
+            ax[1].semilogx([r["dofs"] for r in rr], [r["time_ratio"] for r in rr], mk + "-",
+                           label=p)  # fmt: skip
+    ax[0].set(xlabel="dofs", ylabel="CG iterations per solve", title="Hertz, CG + GAMG")
+    ax[1].axhline(1.0, color="gray", lw=0.8)
+    ax[1].set(xlabel="dofs", ylabel="run time: iterative / direct", title="Hertz")
+    for (eps0, gamma, setup), ls in zip(
+        sorted({(r["eps0"], r["gamma"], r["gamg"]) for r in cuts}), ["-", "--", ":", "-."] * 6
+    ):
+        rr = [r for r in cuts if (r["eps0"], r["gamma"], r["gamg"]) == (eps0, gamma, setup)]
+        its = [r["its_max"] if not r["failed"] else np.nan for r in rr]
+        ax[2].loglog([r["eta"] for r in rr], its, ls, marker=".",
+                     label=f"eps0 {eps0:g}, gamma {gamma:g}, {setup}")  # fmt: skip
+    ax[2].set(xlabel="cut fraction eta", ylabel="max CG iterations per solve",
+              title="cut patch test (failed: gap)")  # fmt: skip
+    for a in ax:
+        a.legend(fontsize=6)
+        a.grid(True, which="both", lw=0.3)
+    fig.tight_layout()
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".png")
+    os.close(fd)
+    fig.savefig(tmp, dpi=110)
+    os.replace(tmp, path)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--divisors", default="20,40,80,160")
+    ap.add_argument("--paths", default="conforming,cut")
+    ap.add_argument("--n", type=int, default=60, help="patch grid: n x n cells")
+    ap.add_argument("--quick", action="store_true", help="eta 0.5, 1e-4, 1e-8; gamma 0, 0.01")
+    ap.add_argument("--skip-hertz", action="store_true")
+    ap.add_argument("--out-dir", default=str(ROOT / "benchmarks" / "results"))
+    ap.add_argument("--timeout", type=float, default=900.0)
+    ap.add_argument("--child", nargs=4, help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.child:
+        path, d, solver, npy = args.child
+        return hertz_child(path, int(d), solver, npy)
+    hertz = []
+    if not args.skip_hertz:
+        with tempfile.TemporaryDirectory() as tmp:
+            divisors = [int(x) for x in args.divisors.split(",")]
+            hertz = hertz_table(args.paths.split(","), divisors, args.timeout, tmp)
+    etas = (0.5, 1e-4, 1e-8) if args.quick else ETAS
+    gammas = (0.0, 0.01) if args.quick else GAMMAS
+    cuts = cuts_table(args.n, etas, gammas, EPS0S)
+    out = Path(args.out_dir)
+    write_atomic(out / "amg.json", json.dumps(dict(hertz=hertz, cuts=cuts), indent=1))
+    write_csv(hertz, out / "amg_hertz.csv")
+    write_csv(cuts, out / "amg_cuts.csv")
+    plot(hertz, cuts, out / "amg.png")
+    print(f"results in {out}/amg.{{json,png}}, amg_hertz.csv, amg_cuts.csv")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
