@@ -89,6 +89,8 @@ def hertz_child(path, divisor, solver, npy):
                 its_max=max(its) if its else None,
                 iterations=its,
                 t_solve=t["solve"],
+                t_amg_setup=getattr(pb.linear, "t_setup", None),
+                t_krylov=getattr(pb.linear, "t_krylov", None),
                 t_run=t["total"] - t["mesh"],
                 pressure_error=m["results"]["pressure_rel_l2_error"],
                 P=abs(m["results"]["reaction"][1]),

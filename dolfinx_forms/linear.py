@@ -159,12 +159,15 @@ class Iterative:
     solve took more than `reuse_growth` times (and `reuse_slack` more than) the iterations of
     the first solve after the last set-up, or failed (then the solve is repeated once).
 
-    Tolerance: ksp_rtol (relative to the right-hand side, Newton's residual R) defaults to a
-    tenth of Newton's relative test (`NewtonOptions.rtol`, 1e-10): once the active set settles
-    one Newton step then lowers the residual below Newton's tolerance, as a direct solve does,
-    so Newton takes the iterations of the direct solvers and the answers agree to Newton's
-    tolerance. (rtol = Newton's rtol left the residual at the threshold: one more Newton
-    iteration at 164k dofs, i.e. another assembly, contact update and two solves.)"""
+    Tolerance: a Newton step solves J du = -R to a residual of a tenth of the residual that
+    Newton must reach (`newton_target`, set by `newton.newton`: rtol r0 of the step, or the
+    round-off floor), whatever |R|: once the active set settles, one step then lowers the
+    residual below Newton's tolerance as a direct solve does, so Newton takes the iterations
+    of the direct solvers and the answers agree to Newton's tolerance. (A tolerance relative
+    to |R| does not: R grows 3x in the first force-control iteration, and rtol 1e-11 |R| left
+    the next residual 10x above the target, one more Newton iteration at 164k dofs.) Other
+    solves (the force control's border, which lifts Dirichlet values) use ksp_rtol, default a
+    tenth of Newton's rtol."""
 
     name = "iterative"
     reuse_growth, reuse_slack = 1.5, 10
@@ -180,6 +183,7 @@ class Iterative:
         for k, v in {"ksp_type": self.krylov, **opts}.items():
             o["ils_" + k] = v
         self.ksp.setFromOptions()
+        self._true_residual()
         self.A = problem.J.duplicate(copy=False)
         self.A.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
         self.A.setNearNullSpace(rigid_modes(problem))
@@ -190,6 +194,10 @@ class Iterative:
         self.rebuild = True
         self.setups = 0
         self.iterations = []  # per solve
+        self.t_setup = self.t_krylov = 0.0  # s: AMG set-ups, Krylov iterations
+        self.rtol = float(opts.get("ksp_rtol", 0.1 * problem.newton.rtol))
+        self.newton_target = None  # force units (newton.newton sets it before each step)
+        self.user_rtol = "ksp_rtol" in (petsc_options or {})  # then for every solve
 
     @property
     def factorisations(self):  # the AMG set-ups, in the place of the direct solvers' count
@@ -202,10 +210,18 @@ class Iterative:
         if self.krylov == "cg" and self.problem.contact.mu > 0:  # friction switched on
             self.krylov = "gmres"
             self.ksp.setType("gmres")
+            self._true_residual()
         self.key = key
         J.copy(self.A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         self.A.zeroRowsColumns(self.problem.bc_global, diag=1.0)
         self._operators(self.rebuild)
+
+    def _true_residual(self):
+        """Test |J x - b| itself (the tolerances are forces): CG's default norm is the
+        preconditioned residual's; GMRES needs right preconditioning for it."""
+        if self.ksp.getType() in ("gmres", "fgmres", "fcg", "bcgs"):
+            self.ksp.setPCSide(PETSc.PC.Side.RIGHT)
+        self.ksp.setNormType(PETSc.KSP.NormType.UNPRECONDITIONED)
 
     def _operators(self, rebuild):
         self.ksp.getPC().setReusePreconditioner(not rebuild)
@@ -224,13 +240,15 @@ class Iterative:
             self.J.mult(self.lift, self.t)
             self.t.aypx(-1.0, b)  # b - J lift: its Dirichlet rows are b_D - b_D = 0
             rhs = self.t
-        self.ksp.solve(rhs, x)
-        its, reason = self.ksp.getIterationNumber(), self.ksp.getConvergedReason()
+        if lifted or self.newton_target is None or self.user_rtol:
+            self.ksp.setTolerances(rtol=self.rtol, atol=1e-50)
+        else:  # |J du + R| <= target / 10; rtol 1e-12: a floor that CG reaches in doubles
+            self.ksp.setTolerances(rtol=1e-12, atol=0.1 * self.newton_target)
+        its, reason = self._solve(rhs, x)
         if reason < 0 and self.fresh is not None:  # a reused AMG that no longer converges
             self._operators(True)
-            self.ksp.solve(rhs, x)
-            its += self.ksp.getIterationNumber()
-            reason = self.ksp.getConvergedReason()
+            its2, reason = self._solve(rhs, x)
+            its += its2
         self.iterations.append(int(its))
         if reason < 0:
             raise LinearSolverError(
@@ -239,9 +257,18 @@ class Iterative:
         if self.fresh is None:
             self.fresh = its
         elif its > max(self.reuse_growth * self.fresh, self.fresh + self.reuse_slack):
-            self.rebuild = True  # at the next set-up
+            self._operators(True)  # now: A is this iteration's J (the border solve follows)
         if lifted:
             x.axpy(1.0, self.lift)
+
+    def _solve(self, rhs, x):
+        t0 = time.perf_counter()
+        self.ksp.setUp()  # the AMG set-up, where one is due
+        t1 = time.perf_counter()
+        self.ksp.solve(rhs, x)
+        self.t_setup += t1 - t0
+        self.t_krylov += time.perf_counter() - t1
+        return self.ksp.getIterationNumber(), self.ksp.getConvergedReason()
 
 
 def rigid_modes(problem):
