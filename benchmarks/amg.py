@@ -6,7 +6,7 @@ fraction (issue 12, item 5).
 Table "hertz": per path (conforming, cut) and mesh divisor (h = a/divisor, the demo's scene
 otherwise), one subprocess per solver runs demos/hertz.py's scene, problem and stages
 (frictionless, force control): "direct" is today's choice (the condensed bulk, else a MUMPS
-LU per changed J), "iterative" the AMG solver. Recorded: dofs, Newton iterations, AMG set-ups,
+LU per changed J), "iterative" the AMG solver (GAMG), "hypre" the same with BoomerAMG (HYPRE). Recorded: dofs, Newton iterations, AMG set-ups,
 Krylov iterations per solve (mean, max), solve-phase and total time (without meshing), peak
 resident memory, p(x) error and reaction P, and for the iterative run the differences to the
 direct one: |u - u_direct|_max / |u_direct|_max, the p(x) error and P.
@@ -15,13 +15,14 @@ Table "cuts": the contact patch test of benchmarks/small_cuts.py (`patch_cut_sce
 interface at y = (k + eta) h so that the lower body's top row has inside fraction eta) on an
 n x n grid, solved with linear_solver="iterative", for eta = 0.5 ... 1e-8, ghost penalty
 gamma in {0, 0.01 (default), 0.1}, the patch test's penalty eps0 = 1e-3 and Hertz's 0.5, and
-two GAMG set-ups: "tuned" (linear.ITERATIVE_OPTIONS) and "petsc" (PETSc's GAMG defaults with
-the same near-null space). Recorded: Krylov iterations per solve (max, mean), Newton
+three set-ups: "tuned" (GAMG, linear.ITERATIVE_OPTIONS), "petsc" (PETSc's GAMG defaults with
+the same near-null space) and "hypre" (BoomerAMG, HYPRE). Recorded: Krylov iterations per solve (max, mean), Newton
 iterations, failure.
 
 Writes (atomically) <out-dir>/amg.json, amg_hertz.csv, amg_cuts.csv and amg.png.
-Usage: /usr/bin/python3 benchmarks/amg.py [--divisors 20,40,80,160] [--paths conforming,cut]
-           [--n 60] [--quick] [--out-dir benchmarks/results] [--timeout 900] [--skip-hertz]
+Usage: /usr/bin/python3 benchmarks/amg.py [--conforming 20,40,80,160,190] [--cut 20,40,80,160]
+           [--solvers direct,iterative,hypre] [--n 60] [--quick] [--skip-hertz]
+           [--out-dir benchmarks/results] [--timeout 900]
 Timings on a shared machine are noisy: compare the ratios of one run.
 """
 
@@ -49,6 +50,17 @@ PETSC_GAMG = {
     "pc_gamg_use_sa_esteig": "1",
     "mg_levels_ksp_chebyshev_esteig_steps": "10",
 }
+# the remedy tried for the cut path: BoomerAMG (no near-null space), HMIS coarsening, ext+i
+# interpolation, strong threshold 0.7 (0.25, hypre's 2D default: 219 iterations on the cut
+# Hertz at 28k dofs, 0.7: 75; GAMG: 428)
+HYPRE = {
+    "pc_type": "hypre",
+    "pc_hypre_boomeramg_strong_threshold": "0.7",
+    "pc_hypre_boomeramg_coarsen_type": "HMIS",
+    "pc_hypre_boomeramg_interp_type": "ext+i",
+    "pc_hypre_boomeramg_P_max": "4",
+}
+SETUPS = {"tuned": None, "petsc": PETSC_GAMG, "hypre": HYPRE}
 
 
 # --------------------------------------------------------------------------- hertz
@@ -57,10 +69,11 @@ def hertz_child(path, divisor, solver, npy):
     from dolfinx_forms.demo import compute
 
     hertz = _hertz_demo()
-    kinds = ["condensed", "factorised"] if solver == "direct" else [solver]
+    kinds = {"direct": ["condensed", "factorised"], "hypre": ["iterative"]}.get(solver, [solver])
     for kind in kinds:
         p = vars(hertz.parse(["--discretization", path, "--linear-solver", kind]))
         p["h"] = hertz.estimate(p)[1] / divisor
+        p["petsc"] = HYPRE if solver == "hypre" else {}
         try:
             run = compute(
                 "hertz", p, hertz.scene, hertz.problem, hertz.stages, hertz.evaluate,
@@ -99,12 +112,13 @@ def hertz_child(path, divisor, solver, npy):
     )
 
 
-def hertz_table(paths, divisors, timeout, tmp):
+def hertz_table(runs, timeout, tmp):
+    """runs: [(path, divisor, solvers)], solvers: "direct" first."""
     rows = []
-    for d in divisors:
-        for path in paths:
+    for path, d, solvers in runs:
+        if True:
             recs = {}
-            for solver in ("direct", "iterative"):
+            for solver in solvers:
                 npy = Path(tmp) / f"u_{path}_{d}_{solver}.npy"
                 cmd = [str(Path(__file__)), "--child", path, str(d), solver, str(npy)]
                 rc, so, se, wall, rss = child(cmd, timeout)
@@ -114,10 +128,13 @@ def hertz_table(paths, divisors, timeout, tmp):
                     r = json.loads(so.strip().splitlines()[-1])
                     r.update(wall=wall, peak_rss_mb=rss)
                 recs[solver] = r
-            di, it = recs["direct"], recs["iterative"]
-            if "error" not in di and "error" not in it:
-                ud, ui = np.load(Path(tmp) / f"u_{path}_{d}_direct.npy"), None
-                ui = np.load(Path(tmp) / f"u_{path}_{d}_iterative.npy")
+            di = recs["direct"]
+            for solver in solvers[1:]:
+                it = recs[solver]
+                if "error" in di or "error" in it:
+                    continue
+                ud = np.load(Path(tmp) / f"u_{path}_{d}_direct.npy")
+                ui = np.load(Path(tmp) / f"u_{path}_{d}_{solver}.npy")
                 it.update(
                     u_rel_diff=float(np.abs(ui - ud).max() / np.abs(ud).max()),
                     pressure_error_diff=abs(it["pressure_error"] - di["pressure_error"]),
@@ -125,7 +142,7 @@ def hertz_table(paths, divisors, timeout, tmp):
                     time_ratio=it["t_run"] / di["t_run"],
                     solve_ratio=it["t_solve"] / di["t_solve"],
                 )
-            for r in (di, it):
+            for r in recs.values():
                 rows.append(r)
                 print(json.dumps({k: v for k, v in r.items() if k != "iterations"}), flush=True)
     return rows
@@ -140,7 +157,7 @@ def cuts_table(n, etas, gammas, eps0s):
     rows = []
     for eps0 in eps0s:
         for gamma in gammas:
-            for setup, opts in (("tuned", None), ("petsc", PETSC_GAMG)):
+            for setup, opts in SETUPS.items():
                 for eta in etas:
                     t0 = time.perf_counter()
                     sc, pb = _patch(patch_problem, n, interface_height(n, eta), gamma, eps0, opts)
@@ -207,17 +224,20 @@ def plot(hertz, cuts, path):
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
-    for p, mk in (("conforming", "o"), ("cut", "s")):
-        rr = [r for r in hertz if r.get("path") == p and r.get("solver") == "iterative"]
+    for (p, solver), mk in zip(
+        [(p, s) for p in ("conforming", "cut") for s in ("iterative", "hypre")], "osv^"
+    ):
+        rr = [r for r in hertz if r.get("path") == p and r.get("solver") == solver]
         rr = [r for r in rr if "dofs" in r]
+        name = {"iterative": "GAMG", "hypre": "BoomerAMG"}[solver]
         if rr:
             n = [r["dofs"] for r in rr]
-            ax[0].loglog(n, [r["its_max"] for r in rr], mk + "-", label=f"{p}: max")
-            ax[0].loglog(n, [r["its_mean"] for r in rr], mk + "--", label=f"{p}: mean")
+            ax[0].loglog(n, [r["its_max"] for r in rr], mk + "-", label=f"{p} {name}: max")
+            ax[0].loglog(n, [r["its_mean"] for r in rr], mk + "--", label=f"{p} {name}: mean")
             rr = [r for r in rr if "time_ratio" in r]
             ax[1].semilogx([r["dofs"] for r in rr], [r["time_ratio"] for r in rr], mk + "-",
-                           label=p)  # fmt: skip
-    ax[0].set(xlabel="dofs", ylabel="CG iterations per solve", title="Hertz, CG + GAMG")
+                           label=f"{p} {name}")  # fmt: skip
+    ax[0].set(xlabel="dofs", ylabel="CG iterations per solve", title="Hertz, CG + AMG")
     ax[1].axhline(1.0, color="gray", lw=0.8)
     ax[1].set(xlabel="dofs", ylabel="run time: iterative / direct", title="Hertz")
     for (eps0, gamma, setup), ls in zip(
@@ -241,8 +261,9 @@ def plot(hertz, cuts, path):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--divisors", default="20,40,80,160")
-    ap.add_argument("--paths", default="conforming,cut")
+    ap.add_argument("--conforming", default="20,40,80,160,190", help="divisors (h = a/d)")
+    ap.add_argument("--cut", default="20,40,80,160", help="divisors of the cut path")
+    ap.add_argument("--solvers", default="direct,iterative,hypre")
     ap.add_argument("--n", type=int, default=60, help="patch grid: n x n cells")
     ap.add_argument("--quick", action="store_true", help="eta 0.5, 1e-4, 1e-8; gamma 0, 0.01")
     ap.add_argument("--skip-hertz", action="store_true")
@@ -256,8 +277,14 @@ def main(argv=None):
     hertz = []
     if not args.skip_hertz:
         with tempfile.TemporaryDirectory() as tmp:
-            divisors = [int(x) for x in args.divisors.split(",")]
-            hertz = hertz_table(args.paths.split(","), divisors, args.timeout, tmp)
+            solvers = ["direct"] + [x for x in args.solvers.split(",") if x != "direct"]
+            runs = [
+                (path, int(d), solvers)
+                for path in ("conforming", "cut")
+                for d in getattr(args, path).split(",")
+                if d
+            ]
+            hertz = hertz_table(runs, args.timeout, tmp)
     etas = (0.5, 1e-4, 1e-8) if args.quick else ETAS
     gammas = (0.0, 0.01) if args.quick else GAMMAS
     cuts = cuts_table(args.n, etas, gammas, EPS0S)

@@ -43,7 +43,7 @@ ITERATIVE_OPTIONS = {
     "pc_gamg_threshold": 0.05,
     "pc_gamg_use_sa_esteig": 0,
     "mg_levels_ksp_chebyshev_esteig_steps": 50,
-    "ksp_max_it": 1000,
+    "ksp_max_it": 3000,
 }
 ITERATIVE_MIN_DOFS = 10**9  # "auto" picks Iterative above it (body-fitted): set by measurement
 KINDS = ("auto", "condensed", "factorised", "iterative")
