@@ -6,9 +6,9 @@ fraction (issue 12, item 5).
 Table "hertz": per path (conforming, cut) and mesh divisor (h = a/divisor, the demo's scene
 otherwise), one subprocess per solver runs demos/hertz.py's scene, problem and stages
 (frictionless, force control): "direct" is today's choice (the condensed bulk, else a MUMPS
-LU per changed J), "iterative" the AMG solver (GAMG), "hypre" the same with BoomerAMG (HYPRE). Recorded: dofs, Newton iterations, AMG set-ups,
-Krylov iterations per solve (mean, max), solve-phase and total time (without meshing), peak
-resident memory, p(x) error and reaction P, and for the iterative run the differences to the
+LU per changed J), "iterative" the AMG solver (GAMG), "hypre" the same with BoomerAMG (HYPRE).
+Recorded: dofs, Newton iterations, AMG set-ups, Krylov iterations per solve (mean, max),
+solve-phase and total time (without meshing), AMG set-up and Krylov time, peak resident memory, p(x) error and reaction P, and for the iterative run the differences to the
 direct one: |u - u_direct|_max / |u_direct|_max, the p(x) error and P.
 
 Table "cuts": the contact patch test of benchmarks/small_cuts.py (`patch_cut_scene`, the
@@ -16,8 +16,8 @@ interface at y = (k + eta) h so that the lower body's top row has inside fractio
 n x n grid, solved with linear_solver="iterative", for eta = 0.5 ... 1e-8, ghost penalty
 gamma in {0, 0.01 (default), 0.1}, the patch test's penalty eps0 = 1e-3 and Hertz's 0.5, and
 three set-ups: "tuned" (GAMG, linear.ITERATIVE_OPTIONS), "petsc" (PETSc's GAMG defaults with
-the same near-null space) and "hypre" (BoomerAMG, HYPRE). Recorded: Krylov iterations per solve (max, mean), Newton
-iterations, failure.
+the same near-null space) and "hypre" (BoomerAMG, HYPRE). Recorded: Krylov iterations per
+solve (max, mean), Newton iterations, failure.
 
 Writes (atomically) <out-dir>/amg.json, amg_hertz.csv, amg_cuts.csv and amg.png.
 Usage: /usr/bin/python3 benchmarks/amg.py [--conforming 20,40,80,160,190] [--cut 20,40,80,160]

@@ -146,13 +146,15 @@ class Iterative:
     the Dirichlet values instead (x_D = b_D, b_F -= J_FD b_D: one product) and iterates on A,
     J with those rows and columns replaced by the identity, which is symmetric positive
     definite where the bulk and the contact tangent are: a linear bulk with frictionless
-    penalty contact (the tangent of eq 48 then is symmetric, `tests/test_iterative.py`).
+    penalty contact (the tangent of eq 48 then is symmetric: |A - A^T| / |A| = 6e-17 on Hertz,
+    `tests/test_iterative.py`).
     Friction (slip: a non-symmetric tangent) or a nonlinear law switch the Krylov method to
     GMRES (`krylov`), with the same preconditioner.
 
-    Why the near-null space: smoothed aggregation interpolates the rigid-body modes on every
-    aggregate (3 in 2D: two translations and the rotation, from the dof coordinates); without
-    them GAMG sees a scalar problem and needs 3-10x the iterations on elasticity.
+    Why the near-null space: smoothed aggregation then interpolates the rigid-body modes on
+    every aggregate (3 in 2D: two translations and the rotation, from the dof coordinates);
+    without them GAMG interpolates the translations only: 77 instead of 61 CG iterations on
+    body-fitted Hertz at 45k dofs, 597 instead of 444 on the cut one at 28k.
 
     Reuse: J changes in a few hundred contact rows between Newton iterations, so the AMG
     hierarchy of an earlier J preconditions a later one almost as well. It is rebuilt when a
