@@ -6,10 +6,12 @@ fraction (issue 12, item 5).
 Table "hertz": per path (conforming, cut) and mesh divisor (h = a/divisor, the demo's scene
 otherwise), one subprocess per solver runs demos/hertz.py's scene, problem and stages
 (frictionless, force control): "direct" is today's choice (the condensed bulk, else a MUMPS
-LU per changed J), "iterative" the AMG solver (GAMG), "hypre" the same with BoomerAMG (HYPRE).
+LU per changed J), "iterative" the AMG solver (GAMG), "hypre" the same with BoomerAMG (HYPRE),
+"factorised" a MUMPS LU per changed J (what a nonlinear law, slip or MPI get today).
 Recorded: dofs, Newton iterations, AMG set-ups, Krylov iterations per solve (mean, max),
-solve-phase and total time (without meshing), AMG set-up and Krylov time, peak resident memory, p(x) error and reaction P, and for the iterative run the differences to the
-direct one: |u - u_direct|_max / |u_direct|_max, the p(x) error and P.
+solve-phase and total time (without meshing), AMG set-up and Krylov time, peak resident
+memory, p(x) error and reaction P, and for the other solvers the differences to the direct
+one: |u - u_direct|_max / |u_direct|_max, the p(x) error and P, and the time ratios.
 
 Table "cuts": the contact patch test of benchmarks/small_cuts.py (`patch_cut_scene`, the
 interface at y = (k + eta) h so that the lower body's top row has inside fraction eta) on an
@@ -21,7 +23,8 @@ solve (max, mean), Newton iterations, failure.
 
 Writes (atomically) <out-dir>/amg.json, amg_hertz.csv, amg_cuts.csv and amg.png.
 Usage: /usr/bin/python3 benchmarks/amg.py [--conforming 20,40,80,160,190] [--cut 20,40,80,160]
-           [--solvers direct,iterative,hypre] [--n 60] [--quick] [--skip-hertz]
+           [--conforming-solvers direct,iterative,factorised] [--cut-solvers direct,iterative,hypre]
+           [--n 60] [--quick] [--skip-hertz]
            [--out-dir benchmarks/results] [--timeout 900]
 Timings on a shared machine are noisy: compare the ratios of one run.
 """
@@ -225,12 +228,17 @@ def plot(hertz, cuts, path):
 
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
     for (p, solver), mk in zip(
-        [(p, s) for p in ("conforming", "cut") for s in ("iterative", "hypre")], "osv^"
+        [(p, s) for p in ("conforming", "cut") for s in ("iterative", "hypre", "factorised")],
+        "osDv^d",
     ):
         rr = [r for r in hertz if r.get("path") == p and r.get("solver") == solver]
         rr = [r for r in rr if "dofs" in r]
-        name = {"iterative": "GAMG", "hypre": "BoomerAMG"}[solver]
-        if rr:
+        name = {"iterative": "GAMG", "hypre": "BoomerAMG", "factorised": "MUMPS LU"}[solver]
+        if rr and solver == "factorised":
+            rr = [r for r in rr if "time_ratio" in r]
+            ax[1].semilogx([r["dofs"] for r in rr], [r["time_ratio"] for r in rr], mk + ":",
+                           label=f"{p} {name}")  # fmt: skip
+        elif rr:
             n = [r["dofs"] for r in rr]
             ax[0].loglog(n, [r["its_max"] for r in rr], mk + "-", label=f"{p} {name}: max")
             ax[0].loglog(n, [r["its_mean"] for r in rr], mk + "--", label=f"{p} {name}: mean")
@@ -263,7 +271,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--conforming", default="20,40,80,160,190", help="divisors (h = a/d)")
     ap.add_argument("--cut", default="20,40,80,160", help="divisors of the cut path")
-    ap.add_argument("--solvers", default="direct,iterative,hypre")
+    ap.add_argument("--conforming-solvers", default="direct,iterative,factorised")
+    ap.add_argument("--cut-solvers", default="direct,iterative,hypre")
     ap.add_argument("--n", type=int, default=60, help="patch grid: n x n cells")
     ap.add_argument("--quick", action="store_true", help="eta 0.5, 1e-4, 1e-8; gamma 0, 0.01")
     ap.add_argument("--skip-hertz", action="store_true")
@@ -277,9 +286,13 @@ def main(argv=None):
     hertz = []
     if not args.skip_hertz:
         with tempfile.TemporaryDirectory() as tmp:
-            solvers = ["direct"] + [x for x in args.solvers.split(",") if x != "direct"]
+            solvers = {
+                p: ["direct"]
+                + [x for x in getattr(args, p + "_solvers").split(",") if x != "direct"]
+                for p in ("conforming", "cut")
+            }
             runs = [
-                (path, int(d), solvers)
+                (path, int(d), solvers[path])
                 for path in ("conforming", "cut")
                 for d in getattr(args, path).split(",")
                 if d
