@@ -21,7 +21,10 @@ three set-ups: "tuned" (GAMG, linear.ITERATIVE_OPTIONS), "petsc" (PETSc's GAMG d
 the same near-null space) and "hypre" (BoomerAMG, HYPRE). Recorded: Krylov iterations per
 solve (max, mean), Newton iterations, failure.
 
-Writes (atomically) <out-dir>/amg.json, amg_hertz.csv, amg_cuts.csv and amg.png.
+Table "bodies": where GAMG stalls on the cut Hertz (`bodies_table`): iterations on the whole
+Jacobian and on each body's block, for the demo's grid grading and a milder one.
+
+Writes (atomically) <out-dir>/amg.json, amg_hertz.csv, amg_cuts.csv, amg_bodies.csv, amg.png.
 Usage: /usr/bin/python3 benchmarks/amg.py [--conforming 20,40,80,160,190] [--cut 20,40,80,160]
            [--conforming-solvers direct,iterative,factorised] [--cut-solvers direct,iterative,hypre]
            [--n 60] [--quick] [--skip-hertz]
@@ -208,6 +211,77 @@ def _patch(patch_problem, n, interface, gamma, eps0, petsc_options):
         small_cuts.ContactProblem = orig
 
 
+# --------------------------------------------------------------------------- bodies
+def bodies_table(divisors, gradings=(None, 1.2)):
+    """Where CG + GAMG stalls on the cut Hertz: the Jacobian at the solution (Dirichlet rows
+    and columns eliminated) and its diagonal blocks of each body (the block has no cut cell;
+    the cylinder is cut), each with its own rigid-body modes, a random right-hand side,
+    rtol 1e-10, linear.ITERATIVE_OPTIONS; for the demo's grid grading (2: cells of aspect
+    ratio up to h_far / h where a fine row crosses a coarse column) and a milder 1.2."""
+    from dolfinx import la
+    from petsc4py import PETSc
+
+    from dolfinx_forms import linear
+    from dolfinx_forms.demo import compute
+
+    hertz = _hertz_demo()
+    rows = []
+    for d in divisors:
+        for grading in gradings:
+            argv = ["--discretization", "cut", "--linear-solver", "factorised"]
+            argv += [] if grading is None else ["--grading", str(grading)]
+            p = vars(hertz.parse(argv))
+            p["h"] = hertz.estimate(p)[1] / d
+            pb = compute("hertz", p, hertz.scene, hertz.problem, hertz.stages).problem
+            pb.residual(pb.lam, with_tangent=True)
+            A = pb.J.copy()
+            A.zeroRowsColumns(pb.bc_global, diag=1.0)
+            X = pb.V.tabulate_dof_coordinates()[:, :2]
+            cells = pb.V.dofmap.list.array.reshape(-1, 4)
+            parts = {"both": np.arange(len(X))}
+            for b in pb.scene.bodies:
+                parts[b.name] = np.unique(cells[pb.scene.cell_tags.find(b.tag)])
+            for name, nodes in parts.items():
+                dofs = (nodes[:, None] * 2 + np.arange(2)).ravel().astype(np.int32)
+                iset = PETSc.IS().createGeneral(dofs)
+                M = A.createSubMatrix(iset, iset)
+                M.setBlockSize(2)
+                modes = [M.createVecLeft() for _ in range(3)]
+                Xc = X[nodes] - X[nodes].mean(axis=0)
+                modes[0].array.reshape(-1, 2)[:, 0] = modes[1].array.reshape(-1, 2)[:, 1] = 1
+                r = modes[2].array.reshape(-1, 2)
+                r[:, 0], r[:, 1] = -Xc[:, 1], Xc[:, 0]
+                la.orthonormalize(modes)
+                M.setNearNullSpace(PETSc.NullSpace().create(vectors=modes))
+                ksp = PETSc.KSP().create(PETSc.COMM_SELF)
+                ksp.setOptionsPrefix("bodies_")
+                o = PETSc.Options()
+                for k, v in {"ksp_type": "cg", **linear.ITERATIVE_OPTIONS}.items():
+                    o["bodies_" + k] = v
+                ksp.setFromOptions()
+                ksp.setTolerances(rtol=1e-10)
+                ksp.setOperators(M)
+                b = M.createVecLeft()
+                b.setRandom()
+                x = b.duplicate()
+                ksp.solve(b, x)
+                grid = pb.scene.cut
+                hx, hy = np.diff(grid.xlines), np.diff(grid.ylines)
+                aspect = max(hx.max() / hy.min(), hy.max() / hx.min())
+                r = dict(
+                    divisor=d,
+                    grading=grading or 2.0,
+                    part=name,
+                    dofs=len(dofs),
+                    its=ksp.getIterationNumber(),
+                    reason=ksp.getConvergedReason(),
+                    max_aspect=float(aspect),
+                )
+                rows.append(r)
+                print(json.dumps(r), flush=True)
+    return rows
+
+
 # --------------------------------------------------------------------------- output
 def write_csv(rows, path):
     keys = list(dict.fromkeys(k for r in rows for k in r if k != "iterations"))
@@ -301,8 +375,11 @@ def main(argv=None):
     etas = (0.5, 1e-4, 1e-8) if args.quick else ETAS
     gammas = (0.0, 0.01) if args.quick else GAMMAS
     cuts = cuts_table(args.n, etas, gammas, EPS0S)
+    bodies = bodies_table([20, 40])
     out = Path(args.out_dir)
-    write_atomic(out / "amg.json", json.dumps(dict(hertz=hertz, cuts=cuts), indent=1))
+    tables = dict(hertz=hertz, cuts=cuts, bodies=bodies)
+    write_atomic(out / "amg.json", json.dumps(tables, indent=1))
+    write_csv(bodies, out / "amg_bodies.csv")
     write_csv(hertz, out / "amg_hertz.csv")
     write_csv(cuts, out / "amg_cuts.csv")
     plot(hertz, cuts, out / "amg.png")
