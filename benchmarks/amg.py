@@ -349,7 +349,9 @@ def main(argv=None):
     ap.add_argument("--cut-solvers", default="direct,iterative,hypre")
     ap.add_argument("--n", type=int, default=60, help="patch grid: n x n cells")
     ap.add_argument("--quick", action="store_true", help="eta 0.5, 1e-4, 1e-8; gamma 0, 0.01")
-    ap.add_argument("--skip-hertz", action="store_true")
+    ap.add_argument(
+        "--skip-hertz", action="store_true", help="keep the hertz table of <out-dir>/amg.json"
+    )
     ap.add_argument("--out-dir", default=str(ROOT / "benchmarks" / "results"))
     ap.add_argument("--timeout", type=float, default=900.0)
     ap.add_argument("--child", nargs=4, help=argparse.SUPPRESS)
@@ -357,7 +359,10 @@ def main(argv=None):
     if args.child:
         path, d, solver, npy = args.child
         return hertz_child(path, int(d), solver, npy)
+    out = Path(args.out_dir)
     hertz = []
+    if args.skip_hertz and (out / "amg.json").exists():  # keep the last run's table
+        hertz = json.loads((out / "amg.json").read_text()).get("hertz", [])
     if not args.skip_hertz:
         with tempfile.TemporaryDirectory() as tmp:
             solvers = {
@@ -376,7 +381,6 @@ def main(argv=None):
     gammas = (0.0, 0.01) if args.quick else GAMMAS
     cuts = cuts_table(args.n, etas, gammas, EPS0S)
     bodies = bodies_table([20, 40])
-    out = Path(args.out_dir)
     tables = dict(hertz=hertz, cuts=cuts, bodies=bodies)
     write_atomic(out / "amg.json", json.dumps(tables, indent=1))
     write_csv(bodies, out / "amg_bodies.csv")
