@@ -97,3 +97,20 @@ def test_patch_iterations_bounded_in_the_cut_fraction(gamma):
     assert ref <= 40
     for eta in (1e-4, 1e-8):
         assert patch_iterations(eta, gamma) <= 1.2 * ref + 2, eta
+
+
+def test_auto_choice(monkeypatch):
+    """ "auto": Iterative for a body-fitted scene from ITERATIVE_MIN_DOFS on (and for options
+    naming GAMG), never for a cut scene; below it today's choice (condensed)."""
+    conforming, _, _ = hertz_problem(scene("conforming"), "factorised")
+    cut, _, _ = hertz_problem(scene("cut"), "factorised")
+    assert linear.choose(conforming, "auto").name == "condensed"
+    assert linear.choose(conforming, "auto", {"pc_type": "gamg"}).name == "iterative"
+    monkeypatch.setattr(linear, "ITERATIVE_MIN_DOFS", conforming.num_dofs)
+    assert linear.choose(conforming, "auto").name == "iterative"
+    assert linear.choose(cut, "auto").name == "condensed"
+    # an explicit "iterative" drops the direct solver's defaults, keeps the user's options
+    it = linear.choose(cut, "iterative", dict(linear.DEFAULT_OPTIONS, ksp_rtol="1e-6"))
+    assert it.krylov == "cg" and it.rtol == 1e-6 and it.user_rtol
+    with pytest.raises(ValueError, match="'iterative'"):
+        linear.choose(cut, "amg")
