@@ -27,7 +27,7 @@ Jacobian and on each body's block, for the demo's grid grading and a milder one.
 Writes (atomically) <out-dir>/amg.json, amg_hertz.csv, amg_cuts.csv, amg_bodies.csv, amg.png.
 Usage: /usr/bin/python3 benchmarks/amg.py [--conforming 20,40,80,160,190] [--cut 20,40,80,160]
            [--conforming-solvers direct,iterative,factorised] [--cut-solvers direct,iterative,hypre]
-           [--n 60] [--quick] [--skip-hertz]
+           [--n 60] [--quick] [--skip-hertz] [--skip-cuts]
            [--out-dir benchmarks/results] [--timeout 900]
 Timings on a shared machine are noisy: compare the ratios of one run.
 """
@@ -352,6 +352,7 @@ def main(argv=None):
     ap.add_argument(
         "--skip-hertz", action="store_true", help="keep the hertz table of <out-dir>/amg.json"
     )
+    ap.add_argument("--skip-cuts", action="store_true", help="keep its cuts table")
     ap.add_argument("--out-dir", default=str(ROOT / "benchmarks" / "results"))
     ap.add_argument("--timeout", type=float, default=900.0)
     ap.add_argument("--child", nargs=4, help=argparse.SUPPRESS)
@@ -379,7 +380,11 @@ def main(argv=None):
             hertz = hertz_table(runs, args.timeout, tmp)
     etas = (0.5, 1e-4, 1e-8) if args.quick else ETAS
     gammas = (0.0, 0.01) if args.quick else GAMMAS
-    cuts = cuts_table(args.n, etas, gammas, EPS0S)
+    last = json.loads((out / "amg.json").read_text()) if (out / "amg.json").exists() else {}
+    if args.skip_cuts:  # keep the last run's table
+        cuts = last.get("cuts", [])
+    else:
+        cuts = cuts_table(args.n, etas, gammas, EPS0S)
     bodies = bodies_table([20, 40])
     tables = dict(hertz=hertz, cuts=cuts, bodies=bodies)
     write_atomic(out / "amg.json", json.dumps(tables, indent=1))
