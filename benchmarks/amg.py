@@ -392,7 +392,7 @@ def main(argv=None):
     write_csv(hertz, out / "amg_hertz.csv")
     write_csv(cuts, out / "amg_cuts.csv")
     plot(hertz, cuts, out / "amg.png")
-    print(f"results in {out}/amg.{{json,png}}, amg_hertz.csv, amg_cuts.csv")
+    print(f"results in {out}/amg.{{json,png}}, amg_hertz.csv, amg_cuts.csv, amg_bodies.csv")
     return 0
 
 
