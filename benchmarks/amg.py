@@ -300,7 +300,7 @@ def plot(hertz, cuts, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2))
+    fig, ax = plt.subplots(1, 3, figsize=(15, 5.2))
     for (p, solver), mk in zip(
         [(p, s) for p in ("conforming", "cut") for s in ("iterative", "hypre", "factorised")],
         "osDv^d",
@@ -321,18 +321,22 @@ def plot(hertz, cuts, path):
                            label=f"{p} {name}")  # fmt: skip
     ax[0].set(xlabel="dofs", ylabel="CG iterations per solve", title="Hertz, CG + AMG")
     ax[1].axhline(1.0, color="gray", lw=0.8)
+    ax[1].set_yscale("log")
     ax[1].set(xlabel="dofs", ylabel="run time: iterative / direct", title="Hertz")
-    for (eps0, gamma, setup), ls in zip(
-        sorted({(r["eps0"], r["gamma"], r["gamg"]) for r in cuts}), ["-", "--", ":", "-."] * 6
-    ):
+    colours = {"tuned": "C0", "petsc": "C3", "hypre": "C2"}
+    styles = {0.0: ":", 0.01: "-", 0.1: "--"}
+    for eps0, gamma, setup in sorted({(r["eps0"], r["gamma"], r["gamg"]) for r in cuts}):
         rr = [r for r in cuts if (r["eps0"], r["gamma"], r["gamg"]) == (eps0, gamma, setup)]
         its = [r["its_max"] if not r["failed"] else np.nan for r in rr]
-        ax[2].loglog([r["eta"] for r in rr], its, ls, marker=".",
+        ax[2].loglog([r["eta"] for r in rr], its, styles.get(gamma, "-."), color=colours[setup],
+                     marker="o" if eps0 >= 0.1 else "x", ms=3,
                      label=f"eps0 {eps0:g}, gamma {gamma:g}, {setup}")  # fmt: skip
     ax[2].set(xlabel="cut fraction eta", ylabel="max CG iterations per solve",
               title="cut patch test (failed: gap)")  # fmt: skip
-    for a in ax:
+    for a in ax[:2]:
         a.legend(fontsize=6)
+    ax[2].legend(fontsize=5, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.15))
+    for a in ax:
         a.grid(True, which="both", lw=0.3)
     fig.tight_layout()
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".png")
@@ -353,10 +357,14 @@ def main(argv=None):
         "--skip-hertz", action="store_true", help="keep the hertz table of <out-dir>/amg.json"
     )
     ap.add_argument("--skip-cuts", action="store_true", help="keep its cuts table")
+    ap.add_argument("--replot", action="store_true", help="only redraw amg.png from amg.json")
     ap.add_argument("--out-dir", default=str(ROOT / "benchmarks" / "results"))
     ap.add_argument("--timeout", type=float, default=900.0)
     ap.add_argument("--child", nargs=4, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.replot:  # redraw amg.png from amg.json
+        t = json.loads((Path(args.out_dir) / "amg.json").read_text())
+        return plot(t["hertz"], t["cuts"], Path(args.out_dir) / "amg.png")
     if args.child:
         path, d, solver, npy = args.child
         return hertz_child(path, int(d), solver, npy)
