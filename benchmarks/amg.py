@@ -46,6 +46,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
 from scaling import _hertz_demo, child, write_atomic  # noqa: E402
+from work_precision import git_head  # noqa: E402
 
 ETAS = (0.5, 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
 GAMMAS = (0.0, 0.01, 0.1)
@@ -394,7 +395,17 @@ def main(argv=None):
     else:
         cuts = cuts_table(args.n, etas, gammas, EPS0S)
     bodies = bodies_table([20, 40])
-    tables = dict(hertz=hertz, cuts=cuts, bodies=bodies)
+    head = git_head()
+    tables = dict(
+        commits=dict(
+            hertz=last.get("commits", {}).get("hertz") if args.skip_hertz else head,
+            cuts=last.get("commits", {}).get("cuts") if args.skip_cuts else head,
+            bodies=head,
+        ),
+        hertz=hertz,
+        cuts=cuts,
+        bodies=bodies,
+    )
     write_atomic(out / "amg.json", json.dumps(tables, indent=1))
     write_csv(bodies, out / "amg_bodies.csv")
     write_csv(hertz, out / "amg_hertz.csv")
