@@ -46,10 +46,10 @@ ITERATIVE_OPTIONS = {
     "ksp_max_it": 3000,
 }
 # "auto" picks Iterative from here on (body-fitted scenes; benchmarks/amg.py, Hertz, side by side
-# with the condensed MUMPS: run time 0.5-1.2x from 45k to 882k dofs, i.e. parity within the
-# noise of a shared machine, but peak memory 1.3 GB instead of 4.2 GB at 702k, 1.6 instead of
-# 5.2 GB at 882k: above ~5e5 dofs MUMPS's memory, not time, is what limits a run). The cut path
-# keeps MUMPS: GAMG needs 300-1700 iterations there (the anisotropic graded grid).
+# with the condensed MUMPS: run time 0.63-1.08x from 45k to 882k dofs, parity within the noise
+# of a shared machine, but peak memory 1.3 GB instead of 4.2 GB at 702k, 1.6 instead of 5.2 GB
+# at 882k: above ~5e5 dofs MUMPS's memory, not its time, is what limits a run). The cut path
+# keeps MUMPS: GAMG needs 260-1360 iterations there (the anisotropic graded grid), 5-19x slower.
 ITERATIVE_MIN_DOFS = 500_000
 KINDS = ("auto", "condensed", "factorised", "iterative")
 
