@@ -75,7 +75,12 @@ class DemoParser(argparse.ArgumentParser):
         if getattr(self, "_discretization", False):  # add_discretization
             check_discretization(self, a)
         if getattr(self, "_petsc_dest", None) is not None:  # add_petsc: KEY=VALUE -> dict
-            setattr(a, self._petsc_dest, petsc_options(self, getattr(a, self._petsc_dest)))
+            # the trial solve reads the options on top of the chosen solver's defaults
+            defaults = (
+                ITERATIVE_DEFAULTS if getattr(a, "linear_solver", "") == "iterative" else None
+            )
+            opts = petsc_options(self, getattr(a, self._petsc_dest), defaults)
+            setattr(a, self._petsc_dest, opts)
         given = sys.argv[1:] if args is None else args
         if (
             getattr(a, "enforcement", None) == "augmented"
@@ -185,9 +190,11 @@ def add_petsc(parser):
     parser._petsc_dest = "petsc"
 
 
-def petsc_options(parser, items):
+def petsc_options(parser, items, defaults=None):
     """Parse repeated --petsc KEY=VALUE into a dict (keys without the leading dash); a dict
-    (already parsed, see add_petsc) is returned as it is."""
+    (already parsed, see add_petsc) is returned as it is. defaults: the solver's options that
+    they override in the trial solve (default SOLVER_DEFAULTS)."""
+    defaults = SOLVER_DEFAULTS if defaults is None else defaults
     if isinstance(items, dict):
         return items
     opts = {}
@@ -207,8 +214,8 @@ def petsc_options(parser, items):
                 "or a value of the wrong kind)"
             )
     if opts:
-        ierr, unread = petsc_trial(opts)
-        every = {**SOLVER_DEFAULTS, **opts}
+        ierr, unread = petsc_trial(opts, defaults)
+        every = {**defaults, **opts}
         given = ", ".join(f"{k}={v}" for k, v in opts.items())
         if ierr is not None:
             parser.error(
@@ -251,6 +258,8 @@ def petsc_refuses(opts):
 # the linear solver's own options (dolfinx_forms/linear.py DEFAULT_OPTIONS), which --petsc
 # overrides: the trial solve reads the user's options on top of them, as the solver does
 SOLVER_DEFAULTS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+# --linear-solver iterative (linear.Iterative: CG + GAMG, its GAMG options in ITERATIVE_OPTIONS)
+ITERATIVE_DEFAULTS = {"ksp_type": "cg", "pc_type": "gamg"}
 
 
 def _petsc_used():
@@ -305,8 +314,9 @@ def _trial_matrix(PETSc, n=12):
     return A
 
 
-def petsc_trial(opts):
-    """Solve a small system with the solver's defaults overridden by `opts` (scratch prefix,
+def petsc_trial(opts, defaults=None):
+    """Solve a small system with the solver's defaults (SOLVER_DEFAULTS unless given)
+    overridden by `opts` (scratch prefix,
     COMM_SELF, removed after; anything PETSc prints, e.g. ksp_view, is discarded). Returns
     (PETSc's error code or None, the keys of `opts` PETSc never read, in their order)."""
     import ctypes
@@ -315,7 +325,7 @@ def petsc_trial(opts):
     from petsc4py import PETSc
 
     o, prefix = PETSc.Options(), "ils_check_"
-    every = {**SOLVER_DEFAULTS, **opts}
+    every = {**(SOLVER_DEFAULTS if defaults is None else defaults), **opts}
     for k, v in every.items():
         o[prefix + k] = v
     A = _trial_matrix(PETSc)
@@ -370,6 +380,7 @@ def demo_parser(prog, doc, out, options=(), discretization=True, petsc=True, cel
         add_cells(p, *cells)
     if petsc:
         add_enforcement(p)
+        add_linear_solver(p)
         add_petsc(p)
     return p
 
@@ -405,6 +416,18 @@ def add_enforcement(parser):
         help="contact enforcement: penalty (the answer depends on --eps0) or augmented "
         "(augmented Lagrangian with one pressure per contact segment: --eps0 sets only the "
         f"speed, default {AUGMENTED_EPS0:g} with it)",
+    )
+
+
+def add_linear_solver(parser):
+    """--linear-solver: Newton's linear solver (dolfinx_forms/linear.py)."""
+    parser.add_argument(
+        "--linear-solver",
+        choices=["auto", "condensed", "factorised", "iterative"],
+        default="auto",
+        help="Newton's linear solver: auto (by the problem), condensed (the bulk factorised "
+        "once, Schur complement on the contact dofs), factorised (MUMPS LU per changed J) or "
+        "iterative (CG/GMRES + GAMG with the rigid-body modes; --petsc options apply)",
     )
 
 

@@ -122,6 +122,8 @@ def newton(problem, lam, r_ref=0.0):
             )
             key = None if slip else (sig, problem.contact.mu)
         r_base, sig_base, backtracks = r, sig, 0
+        # the residual Newton must reach: what an iterative linear solver has to resolve
+        problem.linear.newton_target = max(opts.rtol * r0, opts.ftol * problem.force_scale)
         with problem.phase("solve"):
             problem.R.scale(-1.0)
             try:  # linear.py: a full factorisation, or the condensed bulk

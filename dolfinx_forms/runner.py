@@ -138,6 +138,7 @@ def build_problem(spec, scene, timer=None, log=print):
     loads.update({f["name"]: ld for f, ld in zip(spec["body_forces"], forces)})
     s = spec["solver"]
     options = "mu eps0 band grid_refine num_gauss ghost_penalty quadrature_degree cut_degree"
+    options += " linear_solver"
     problem = ContactProblem(
         scene,
         {tags[b["name"]]: make_law(b["law"]) for b in spec["bodies"]},

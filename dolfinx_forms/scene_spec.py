@@ -19,7 +19,8 @@ tan, exp, log, abs):
               structured [false] (boxes without a window: transfinite grids of about h)
       both:   contact_box [the pairs' overlaps] (cells owned by MPI rank 0)
   [solver]  eps0 [1.0], band [2 h], mu [0.0], ghost_penalty [0.01], grid_refine [4],
-      num_gauss [2], steps [1], quadrature_degree, cut_degree [4], petsc {KEY = VALUE},
+      num_gauss [2], steps [1], quadrature_degree, cut_degree [4], linear_solver ["auto"]
+      ("condensed", "factorised", "iterative": dolfinx_forms/linear.py), petsc {KEY = VALUE},
       newton {rtol, ftol, atol, stol, max_iterations, max_cutbacks}
   [[bodies]]  name, shape = {type = "circle", centre, radius} | {type = "ellipse", centre,
       axes = [a, b], angle [0, degrees]} | {type = "box", min, max} | {type = "polygon",
@@ -295,6 +296,9 @@ def _solver(t):
         steps=t.integer("steps", 1, lo=1, hi=1000),
         quadrature_degree=t.integer("quadrature_degree", None, lo=1, hi=20),
         cut_degree=t.integer("cut_degree", 4, lo=1, hi=20),
+        linear_solver=t.string(
+            "linear_solver", "auto", choices=["auto", "condensed", "factorised", "iterative"]
+        ),
     )
     petsc = t.table("petsc", {})
     s["petsc"] = {}

@@ -54,8 +54,10 @@ class ContactProblem:
     default "P1" with "augmented", None with "penalty". multiplier_length: default h body-fitted,
     1.5 h cut (Hertz at h = a/20, P1: 0.5 h and, on the cut path, 0.75 h give a checkerboard;
     p(x) 1.9 / 2.3 / 3.1 % body-fitted at 0.75 / 1 / 1.5 h, 3.9 / 3.4 % cut at 1 / 1.5 h).
-    linear_solver: "auto", "condensed" or "factorised" (`linear.py`: a linear bulk on one
-    process is factorised once, with Newton on the Schur complement of the contact dofs).
+    linear_solver: "auto", "condensed", "factorised" or "iterative" (`linear.py`: a linear bulk
+    on one process is factorised once, with Newton on the Schur complement of the contact dofs;
+    "iterative": CG + GAMG with the rigid-body modes, chosen by "auto" for large body-fitted
+    problems).
     """
 
     def __init__(
@@ -332,6 +334,12 @@ def solver_metrics(problem, converged=True):
         "linear_solver": problem.linear.name,
         "schur_factorisations": int(getattr(problem.linear, "schur_factorisations", 0)),
         "condensed_dofs": int(getattr(problem.linear, "num_dofs", 0)),
+        # Krylov iterations per linear solve (the iterative solver only)
+        **(
+            {"linear_iterations": list(problem.linear.iterations)}
+            if hasattr(problem.linear, "iterations")
+            else {}
+        ),
     }
 
 

@@ -74,7 +74,7 @@ def test_choice():
     sc = scene("cut")
     pb = mindlin(sc, "auto")
     assert pb.linear.name == "condensed"
-    with pytest.raises(ValueError, match="linear_solver: 'auto', 'condensed' or 'factorised'"):
+    with pytest.raises(ValueError, match="linear_solver: 'auto', 'condensed', 'factorised', 'iterative'"):
         linear.choose(pb, "schur")
     # the user's solver options are honoured: a full factorisation
     assert linear.choose(pb, "auto", {"pc_factor_mat_solver_type": "superlu"}).name == "factorised"
