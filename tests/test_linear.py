@@ -73,8 +73,13 @@ def test_condensed_equals_factorised(kind):
 def test_choice():
     sc = scene("cut")
     pb = mindlin(sc, "auto")
-    assert pb.linear.name == "condensed"
-    with pytest.raises(ValueError, match="linear_solver: 'auto', 'condensed', 'factorised', 'iterative'"):
+    # the choice, not its timing: on a loaded machine a dense update may cost more than
+    # twice the sparse factorisation and hand over (`test_hand_over_...`)
+    assert isinstance(pb.linear, linear.Condensed)
+    assert linear.choose(pb, "auto").name == "condensed"
+    with pytest.raises(
+        ValueError, match="linear_solver: 'auto', 'condensed', 'factorised', 'iterative'"
+    ):
         linear.choose(pb, "schur")
     # the user's solver options are honoured: a full factorisation
     assert linear.choose(pb, "auto", {"pc_factor_mat_solver_type": "superlu"}).name == "factorised"
