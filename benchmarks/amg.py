@@ -43,10 +43,10 @@ from pathlib import Path
 
 import numpy as np
 
+from scaling import _hertz_demo, child, write_atomic  # the script's folder is on sys.path
+from work_precision import git_head
+
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "benchmarks"))
-from scaling import _hertz_demo, child, write_atomic  # noqa: E402
-from work_precision import git_head  # noqa: E402
 
 ETAS = (0.5, 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
 GAMMAS = (0.0, 0.01, 0.1)
