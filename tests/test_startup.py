@@ -76,3 +76,40 @@ def test_cut_demo_imports(tmp_path):
         "print(json.dumps([m for m in ('dolfinx', 'mpi4py') if m in sys.modules]))"
     )
     assert r == []
+
+
+def _lines():
+    import numpy as np
+
+    x = np.linspace(-1, 1, 200)
+    return {"p_n computed": (x, 1 - x**2, "."), "Hertz": (x, np.sqrt(1 - x**2), "-")}
+
+
+def test_plot_worker_draws_the_same_png(tmp_path):
+    """The worker's PNG is byte for byte the in-process one; it is used once, then plot_lines
+    draws in-process again."""
+    from dolfinx_forms import output, plot_worker
+
+    plot_worker.draw(tmp_path / "here.png", _lines(), "t", "x", "y", (0.5,))
+    output.start_plot_worker()
+    worker = output._worker
+    output.plot_lines(tmp_path / "worker.png", _lines(), "t", "x", "y", (0.5,))
+    assert output._worker is None and worker.proc.returncode == 0
+    assert (tmp_path / "worker.png").read_bytes() == (tmp_path / "here.png").read_bytes()
+    output.plot_lines(tmp_path / "again.png", _lines(), "t", "x", "y", (0.5,))
+    assert (tmp_path / "again.png").read_bytes() == (tmp_path / "here.png").read_bytes()
+
+
+def test_plot_worker_errors_and_unused(tmp_path):
+    """An error in the worker is raised in the caller; an unused worker is ended."""
+    import pytest
+
+    from dolfinx_forms import output
+
+    output.start_plot_worker()
+    with pytest.raises(RuntimeError, match="plot worker"):
+        output.plot_lines(tmp_path / "missing" / "x.png", _lines())
+    output.start_plot_worker()
+    proc = output._worker.proc
+    output.stop_plot_worker()
+    assert proc.poll() is not None and output._worker is None
