@@ -1,10 +1,10 @@
 """Line plots (output.plot_lines), drawn in this process or in a worker process started early.
 
-A demo's default plot (tractions.png) costs ~0.6 s of a ~1.5 s process: matplotlib's import
-(0.3-0.4 s), the drawing, and its objects' clean-up at exit (0.1 s). `start()` (demo.run_case,
-before the run computes) launches `python3 -P plot_worker.py`, which imports matplotlib while
-the run computes, then draws the one figure it receives, replies and exits at once; the
-figure is the one `draw` makes in-process (same code, same matplotlib, same PNG).
+A demo's default plot (tractions.png) costs ~0.5 s of a ~1.5 s process: matplotlib's import
+(0.3-0.4 s) and the drawing (0.1 s). When a core is idle, `start()` (demo.run_case, before the
+run computes) launches `python3 -P plot_worker.py`, which imports matplotlib while the run
+computes, then draws the one figure it receives, replies and exits at once; the figure is the
+one `draw` makes in-process (same code, same matplotlib, same PNG bytes).
 
 Protocol: the parent writes one pickled (path, lines, title, xlabel, ylabel, vlines) to the
 worker's stdin and closes it; the worker answers "ok" or the error's traceback on stdout. An
@@ -74,7 +74,12 @@ class Worker:
 
 
 def start():
-    """A Worker, or None if no process can be started (the plot is then drawn in-process)."""
+    """A Worker, or None (the plot is then drawn in-process): when no core is idle (1-minute
+    load average above the cores less one) or no process can be started. On a busy machine
+    the worker does not run beside the run but takes its CPU (a second interpreter, and the
+    BLAS threads of the factorisations wait for a core): measured 0.1-0.2 s slower there."""
+    if os.getloadavg()[0] > (os.cpu_count() or 1) - 1:
+        return None
     try:
         return Worker()
     except OSError:

@@ -91,8 +91,7 @@ def test_plot_worker_draws_the_same_png(tmp_path):
     from dolfinx_forms import output, plot_worker
 
     plot_worker.draw(tmp_path / "here.png", _lines(), "t", "x", "y", (0.5,))
-    output.start_plot_worker()
-    worker = output._worker
+    output._worker = worker = plot_worker.Worker()  # start_plot_worker: none on a busy machine
     output.plot_lines(tmp_path / "worker.png", _lines(), "t", "x", "y", (0.5,))
     assert output._worker is None and worker.proc.returncode == 0
     assert (tmp_path / "worker.png").read_bytes() == (tmp_path / "here.png").read_bytes()
@@ -104,12 +103,32 @@ def test_plot_worker_errors_and_unused(tmp_path):
     """An error in the worker is raised in the caller; an unused worker is ended."""
     import pytest
 
-    from dolfinx_forms import output
+    from dolfinx_forms import output, plot_worker
 
-    output.start_plot_worker()
+    output._worker = plot_worker.Worker()
     with pytest.raises(RuntimeError, match="plot worker"):
         output.plot_lines(tmp_path / "missing" / "x.png", _lines())
-    output.start_plot_worker()
-    proc = output._worker.proc
+    output._worker = worker = plot_worker.Worker()
     output.stop_plot_worker()
-    assert proc.poll() is not None and output._worker is None
+    assert worker.proc.poll() is not None and output._worker is None
+
+
+def test_plot_worker_only_when_a_core_is_idle(monkeypatch):
+    from dolfinx_forms import plot_worker
+
+    monkeypatch.setattr(plot_worker.os, "getloadavg", lambda: (64.0, 64.0, 64.0))
+    assert plot_worker.start() is None
+    monkeypatch.setattr(plot_worker.os, "getloadavg", lambda: (0.0, 0.0, 0.0))
+    worker = plot_worker.start()
+    assert worker is not None
+    worker.close()
+
+
+def test_exit_process_status():
+    """cli.exit_process: the status reaches the shell (0, 1)."""
+    for status in (0, 1):
+        p = subprocess.run(
+            [sys.executable, "-c", f"from dolfinx_forms import cli; cli.exit_process({status})"],
+            env=dict(os.environ, PYTHONPATH=str(ROOT)),
+        )
+        assert p.returncode == status
