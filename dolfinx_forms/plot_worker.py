@@ -74,11 +74,12 @@ class Worker:
 
 
 def start():
-    """A Worker, or None (the plot is then drawn in-process): when no core is idle (1-minute
-    load average above the cores less one) or no process can be started. On a busy machine
-    the worker does not run beside the run but takes its CPU (a second interpreter, and the
-    BLAS threads of the factorisations wait for a core): measured 0.1-0.2 s slower there."""
-    if os.getloadavg()[0] > (os.cpu_count() or 1) - 1:
+    """A Worker, or None (the plot is then drawn in-process): when no core is idle besides the
+    run's own (1-minute load average above the cores less 0.5) or no process can be started.
+    On a busy machine the worker does not run beside the run but takes its CPU (a second
+    interpreter, and the BLAS threads of the factorisations wait for a core): measured 0.1-0.2 s
+    slower there."""
+    if os.getloadavg()[0] > (os.cpu_count() or 1) - 0.5:
         return None
     try:
         return Worker()
