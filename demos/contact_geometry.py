@@ -16,7 +16,6 @@ Results and discussion: docs/demos.md#contact-geometry
 """
 
 import csv
-import sys
 from types import SimpleNamespace
 
 import numpy as np
@@ -157,4 +156,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    cli.exit_process(main())

@@ -7,6 +7,7 @@ return mapping). Equation numbers refer to Liu & Sun, ILS-MPM (seed paper 000).
 """
 
 import os
+import sys
 
 # A process started without mpirun is an Open MPI singleton: by default its MPI_Init starts a
 # helper daemon (for MPI_Comm_spawn, which this code never calls), ~0.4 s of every run's start.
@@ -65,7 +66,20 @@ def _setup():
     from . import logs
 
     logs.configure()
-    from mpi4py import MPI
+    # A singleton's only peer is itself, yet Open MPI's default point-to-point layer (UCX) and
+    # transports (TCP, shared memory) probe the machine for ~0.2 s in MPI_Init. The setting
+    # is read by MPI_Init only and removed after it: an mpirun started from this process must
+    # not inherit btl=self. A launched process (mpirun, srun, hydra) keeps the defaults.
+    launched = ("OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE", "SLURM_PROCID")
+    singleton = {"OMPI_MCA_pml": "ob1", "OMPI_MCA_btl": "self"}
+    if "mpi4py.MPI" in sys.modules or any(k in os.environ for k in launched + (*singleton,)):
+        singleton = {}
+    os.environ.update(singleton)
+    try:
+        from mpi4py import MPI
+    finally:
+        for k in singleton:
+            del os.environ[k]
 
     if MPI.COMM_WORLD.size > 1:
         from . import parallel
@@ -73,6 +87,29 @@ def _setup():
         parallel.install()
 
 
+def _import_ufl_ffcx():
+    """Debian's ufl and ffcx (2022.2, 0.5) read their own version at import with pkg_resources,
+    which scans every installed distribution (0.1 s, a third of importing dolfinx). These two
+    imports see a stand-in whose get_distribution answers from importlib.metadata, the same
+    version string; pkg_resources itself stays importable (the stand-in is removed after)."""
+    if any(m in sys.modules for m in ("pkg_resources", "ufl", "ffcx")):
+        return
+    import importlib.metadata
+    import types
+
+    def get_distribution(name):
+        return types.SimpleNamespace(version=importlib.metadata.version(name))
+
+    sys.modules["pkg_resources"] = types.ModuleType("pkg_resources", "ufl/ffcx stand-in")
+    sys.modules["pkg_resources"].get_distribution = get_distribution
+    try:
+        import ffcx  # noqa: F401
+        import ufl  # noqa: F401
+    finally:
+        del sys.modules["pkg_resources"]
+
+
+_import_ufl_ffcx()
 _setup()
 
 

@@ -11,7 +11,7 @@ written); 2 a bad description, option or --out (one line naming the key, nothing
 
 import sys
 
-from .cli import DemoParser
+from .cli import DemoParser, exit_process
 from .folders import OutputFolderError
 from .scene_spec import SpecError
 
@@ -86,4 +86,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_process(main())

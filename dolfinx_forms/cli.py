@@ -10,6 +10,7 @@ parsing (rules: folders.py), so a run never computes and then refuses its output
 
 import argparse
 import copy
+import gc
 import math
 import re
 import sys
@@ -460,3 +461,11 @@ def check_discretization(parser, args):
     """The cut path is vector Q1 on quadrilaterals."""
     if args.discretization == "cut" and getattr(args, "degree", 1) != 1:
         parser.error(f"--degree: the cut discretization supports degree 1 only, got {args.degree}")
+
+
+def exit_process(status):
+    """sys.exit(status) at the end of a program's __main__. gc.freeze() first: the interpreter's
+    clean-up then skips its garbage collections over every object still alive (matplotlib's,
+    dolfinx's: 0.1-0.2 s of each run); objects are still released, PETSc and MPI finalized."""
+    gc.freeze()
+    sys.exit(status)

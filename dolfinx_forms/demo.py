@@ -220,29 +220,37 @@ def run_case(
     ...". Returns the exit status: 0, or 1 after a ContactSolverError (one line "prog: message"
     on stderr, nothing written). params: every input after defaults (metrics.json's
     "parameters"), usually dict(vars(args), derived values...)."""
+    from mpi4py import MPI
+
+    from . import output
+
     prog = prog or Path(sys.argv[0]).name
     out = params["out"] if out is None else out
     force = params.get("force", False) if force is None else force
+    rank0 = (comm or MPI.COMM_WORLD).rank == 0
+    if plot is traction_plot and rank0:  # matplotlib's import and clean-up overlap the run
+        output.start_plot_worker()
     try:
-        run = compute(
-            name,
-            params,
-            build_scene,
-            build_problem,
-            stages,
-            evaluate,
-            discretization=discretization,
-            reactions=reactions,
-            collect=collect,
-            comm=comm,
-        )
-    except ContactSolverError as e:
-        from mpi4py import MPI
-
-        if (comm or MPI.COMM_WORLD).rank == 0:
-            sys.stderr.write(f"{prog}: {e}\n")
-        return 1
-    folder = write(run, out, force, plot=plot, files=files)
+        try:
+            run = compute(
+                name,
+                params,
+                build_scene,
+                build_problem,
+                stages,
+                evaluate,
+                discretization=discretization,
+                reactions=reactions,
+                collect=collect,
+                comm=comm,
+            )
+        except ContactSolverError as e:
+            if rank0:
+                sys.stderr.write(f"{prog}: {e}\n")
+            return 1
+        folder = write(run, out, force, plot=plot, files=files)
+    finally:
+        output.stop_plot_worker()
     if run.rank0:
         for w in run.metrics.get("solver", {}).get("warnings", []):
             print(f"WARNING: {w}")

@@ -7,6 +7,7 @@ import numpy as np
 
 from .results import atomic_output_dir as atomic_output  # noqa: F401 (demos use it)
 from .results import write_metrics
+from . import plot_worker
 from .contact_set import STATE_NAMES
 
 TRACTION_COLUMNS = ("x", "y", "p_n", "p_t", "gap_n", "slip", "state")
@@ -81,25 +82,31 @@ def plot_tractions(path, pts, analytic=None, title="", xlabel="x (mm)", ylabel="
 
 def plot_lines(path, lines, title="", xlabel="x (mm)", ylabel="", vlines=()):
     """Curves {label: (x, y, style)} (style "-": a line, ".": points) and dotted vertical lines
-    at the abscissae `vlines`, in one PNG."""
-    import matplotlib
+    at the abscissae `vlines`, in one PNG (plot_worker.draw; in the worker of
+    `start_plot_worker` if one was started and is unused)."""
+    global _worker
+    worker, _worker = _worker, None
+    if worker is None or not worker.plot(path, lines, title, xlabel, ylabel, vlines):
+        plot_worker.draw(path, lines, title, xlabel, ylabel, vlines)
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7, 4))
-    for label, (x, y, style) in lines.items():
-        ax.plot(x, y, style, label=label, **(dict(ms=3) if style == "." else dict(lw=1)))
-    for xv in vlines:
-        ax.axvline(xv, color="0.6", lw=0.8, ls=":")
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.set_title(title)
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+_worker = None  # plot_worker.Worker of start_plot_worker, until plot_lines uses it
+
+
+def start_plot_worker():
+    """Start a worker process for the next plot_lines figure (plot_worker.py); a previous
+    unused one is ended."""
+    global _worker
+    stop_plot_worker()
+    _worker = plot_worker.start()
+
+
+def stop_plot_worker():
+    """End the worker of start_plot_worker if plot_lines did not use it."""
+    global _worker
+    worker, _worker = _worker, None
+    if worker is not None:
+        worker.close()
 
 
 def finish(folder, metrics, problem, pts, plot=None):

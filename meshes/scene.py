@@ -29,12 +29,11 @@ import contextlib
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-import dolfinx
-import dolfinx.cpp
-import dolfinx.mesh
 import numpy as np
 
 if TYPE_CHECKING:
+    import dolfinx.mesh
+
     from .cut import CutData
 
 __all__ = [
@@ -123,13 +122,14 @@ def _gmsh_initialized(gmsh) -> bool:
 @contextlib.contextmanager
 def gmsh_model(comm, name: str):
     """Rank 0: an initialized, quiet gmsh with a fresh current model `name`; other ranks: nothing.
+    comm None: this process alone, without MPI (GetFEM's benchmark meshes without mpi4py).
 
     If gmsh was not initialized it is initialized here and finalized on exit; otherwise only the
     model is removed and the options changed here are restored. If the body raises on rank 0,
     the error is broadcast (matching the first collective of :func:`scene_from_gmsh`) so the
     other ranks raise too instead of hanging.
     """
-    if comm.rank != 0:
+    if comm is not None and comm.rank != 0:
         yield None
         return
     import gmsh
@@ -145,7 +145,7 @@ def gmsh_model(comm, name: str):
     try:
         yield gmsh
     except BaseException as e:
-        if comm.size > 1 and _state["status_pending"]:
+        if comm is not None and comm.size > 1 and _state["status_pending"]:
             comm.bcast(("error", f"rank 0 failed building gmsh model {name!r}: {e!r}"), root=0)
         raise
     finally:
@@ -272,6 +272,9 @@ def contact_partitioner(x: np.ndarray, cells: np.ndarray, cell_name: str, contac
         owners = np.asarray(contact_box["owners"], np.int32)
         contact_box = contact_box["boxes"]
     boxes = np.asarray(contact_box, dtype=float).reshape(-1, 2, 2)
+    import dolfinx.cpp  # dolfinx where meshes are made: gmsh_model alone needs none (GetFEM)
+    import dolfinx.mesh
+
     AdjacencyList_int32 = dolfinx.cpp.graph.AdjacencyList_int32
 
     def partition(comm, nparts, tdim, graph, ghost_mode):
@@ -376,6 +379,8 @@ def tag_boundaries(mesh, cell_values, bodies, boundary_markers):
     """(facet_tags named "boundaries", boundaries name -> tag value) from boundary_markers
     (name -> (tag, predicate[, body]), see :func:`scene_from_gmsh`); cell_values: body tag of
     every local cell (owned and ghost), used by the markers restricted to one body."""
+    import dolfinx.mesh
+
     tdim = mesh.topology.dim
     mesh.topology.create_connectivity(tdim - 1, tdim)
     f2c = mesh.topology.connectivity(tdim - 1, tdim)
@@ -407,7 +412,7 @@ def scene_from_gmsh(
     pairs,
     h_contact,
     contact_box=None,
-    ghost_mode=dolfinx.mesh.GhostMode.shared_facet,
+    ghost_mode=None,
 ) -> Scene:
     """Collective: build the Scene from the meshed gmsh model on rank 0 (first-order 2D cells).
 
@@ -417,7 +422,8 @@ def scene_from_gmsh(
     where two bodies have coincident facets. A facet gets the first matching name (dict order).
     contact_box: (2, 2) [[xmin, ymin], [xmax, ymax]] (or (k, 2, 2), a union of boxes) whose
     cells are all owned by rank 0; None (default): derived from the pairs and the bodies' bboxes
-    (:func:`pairs_contact_boxes`); False: DOLFINx's graph partitioner.
+    (:func:`pairs_contact_boxes`); False: DOLFINx's graph partitioner. ghost_mode: DOLFINx's
+    GhostMode (default shared_facet).
     """
     status = None
     if comm.rank == 0:
@@ -435,7 +441,9 @@ def scene_from_gmsh(
         x, cells = np.zeros((0, 2)), np.zeros((0, nv), np.int64)
 
     import dolfinx.io.gmshio
+    import dolfinx.mesh
 
+    ghost_mode = dolfinx.mesh.GhostMode.shared_facet if ghost_mode is None else ghost_mode
     domain = dolfinx.io.gmshio.ufl_mesh(gtype, 2)
     kwargs = partitioner_kwargs(comm, x, cells, cell_name, contact_box, bodies, pairs, h_contact)
     mesh = dolfinx.mesh.create_mesh(comm, cells, x, domain, ghost_mode=ghost_mode, **kwargs)

@@ -1,0 +1,114 @@
+"""Line plots (output.plot_lines), drawn in this process or in a worker process started early.
+
+A demo's default plot (tractions.png) costs ~0.5 s of a ~1.5 s process: matplotlib's import
+(0.3-0.4 s) and the drawing (0.1 s). When a core is idle, `start()` (demo.run_case, before the
+run computes) launches `python3 -P plot_worker.py`, which imports matplotlib while the run
+computes, then draws the one figure it receives, replies and exits at once; the figure is the
+one `draw` makes in-process (same code, same matplotlib, same PNG bytes).
+
+Protocol: the parent writes one pickled (path, lines, title, xlabel, ylabel, vlines) to the
+worker's stdin and closes it; the worker answers "ok" or the error's traceback on stdout. An
+empty stdin (the run failed, nothing to plot) ends the worker. The worker ignores SIGINT (the
+parent's Ctrl-C handling decides what remains) and imports nothing of this package (no MPI).
+"""
+
+import os
+import pickle
+import subprocess
+import sys
+
+
+def draw(path, lines, title="", xlabel="x (mm)", ylabel="", vlines=()):
+    """Curves {label: (x, y, style)} (style "-": a line, ".": points) and dotted vertical lines
+    at the abscissae `vlines`, in one PNG."""
+    import matplotlib  # only here: most of a run never plots
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for label, (x, y, style) in lines.items():
+        ax.plot(x, y, style, label=label, **(dict(ms=3) if style == "." else dict(lw=1)))
+    for xv in vlines:
+        ax.axvline(xv, color="0.6", lw=0.8, ls=":")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+class Worker:
+    """A started worker process: `plot` (once) or `close`."""
+
+    def __init__(self):
+        # -P: not this folder first on sys.path (its module names must not shadow matplotlib's)
+        self.proc = subprocess.Popen(
+            [sys.executable, "-P", os.path.abspath(__file__)],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+        )
+
+    def plot(self, *args):
+        """Draw draw(*args) in the worker; False if the worker is gone (the caller draws)."""
+        try:
+            reply, _ = self.proc.communicate(pickle.dumps(args))
+        except OSError:  # BrokenPipeError: it died before reading
+            self.close()
+            return False
+        if self.proc.returncode != 0 or not reply:
+            return False
+        if reply != b"ok":
+            raise RuntimeError(f"plotting {args[0]} failed in the plot worker:\n{reply.decode()}")
+        return True
+
+    def close(self):
+        """End an unused worker (the run failed or plotted nothing)."""
+        if self.proc.poll() is None:
+            self.proc.kill()
+        self.proc.communicate()
+
+
+def start():
+    """A Worker, or None (the plot is then drawn in-process): when no core is idle besides the
+    run's own (1-minute load average above the cores less 0.5) or no process can be started.
+    On a busy machine the worker does not run beside the run but takes its CPU (a second
+    interpreter, and the BLAS threads of the factorisations wait for a core): measured 0.1-0.2 s
+    slower there."""
+    if os.getloadavg()[0] > (os.cpu_count() or 1) - 0.5:
+        return None
+    try:
+        return Worker()
+    except OSError:
+        return None
+
+
+def _serve():
+    import signal
+    import traceback
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    import matplotlib  # now, while the parent computes
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot  # noqa: F401
+
+    data = sys.stdin.buffer.read()
+    if data:
+        try:
+            draw(*pickle.loads(data))
+            reply = b"ok"
+        except BaseException:
+            reply = traceback.format_exc().encode()
+        sys.stdout.buffer.write(reply)
+        sys.stdout.flush()
+    # the figure is written and closed: skip the interpreter's clean-up of matplotlib (0.1 s)
+    os._exit(0)
+
+
+if __name__ == "__main__":
+    _serve()

@@ -1,0 +1,134 @@
+"""Process start-up of the cut Hertz demo (issue 12, item 3): what a run imports and what it
+leaves in the environment. Each check is a fresh interpreter (imports are per process)."""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _python(code, **env):
+    e = dict(os.environ, PYTHONPATH=str(ROOT), **env)
+    for k in ("OMPI_MCA_pml", "OMPI_MCA_btl"):  # as a user's shell has them: unset
+        if k not in env:
+            e.pop(k, None)
+    p = subprocess.run([sys.executable, "-c", code], env=e, capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+IMPORTS = """
+import json, os, sys
+import dolfinx_forms, dolfinx, dolfinx.fem.petsc, ufl, ffcx
+from mpi4py import MPI
+print(json.dumps(dict(
+    modules=[m for m in ("gmsh", "pkg_resources", "matplotlib") if m in sys.modules],
+    env={k: os.environ.get(k) for k in ("OMPI_MCA_pml", "OMPI_MCA_btl")},
+    versions=[ufl.__version__, ffcx.__version__], size=MPI.COMM_WORLD.size)))
+"""
+
+
+def test_library_import_is_lean():
+    """No gmsh, pkg_resources or matplotlib on import; ufl and ffcx know their versions; the
+    singleton's MPI settings are gone from the environment (an mpirun started from here must
+    not inherit btl=self)."""
+    r = _python(IMPORTS)
+    assert r["modules"] == []
+    assert r["env"] == {"OMPI_MCA_pml": None, "OMPI_MCA_btl": None}
+    from importlib.metadata import version
+
+    assert r["versions"] == [version("fenics-ufl"), version("fenics-ffcx")]
+    assert r["size"] == 1
+
+
+def test_user_mpi_settings_kept():
+    """A user's own pml/btl choice is neither overridden nor removed."""
+    r = _python(IMPORTS, OMPI_MCA_pml="ob1", OMPI_MCA_btl="self,vader")
+    assert r["env"] == {"OMPI_MCA_pml": "ob1", "OMPI_MCA_btl": "self,vader"}
+
+
+def test_pkg_resources_still_works_after():
+    r = _python(
+        "import json, dolfinx_forms, pkg_resources\n"
+        "print(json.dumps([pkg_resources.get_distribution('fenics-ufl').version,"
+        " hasattr(pkg_resources, 'iter_entry_points')]))"
+    )
+    from importlib.metadata import version
+
+    assert r == [version("fenics-ufl"), True]
+
+
+def test_cut_demo_imports(tmp_path):
+    """The cut demo's module imports neither gmsh nor matplotlib (the plot imports it when it
+    draws); the GetFEM benchmark's mesher imports neither dolfinx nor mpi4py."""
+    r = _python(
+        "import json, runpy, sys\n"
+        f"runpy.run_path({str(ROOT / 'demos' / 'hertz.py')!r}, run_name='not_main')\n"
+        "print(json.dumps([m for m in ('gmsh', 'matplotlib', 'pkg_resources') if m in sys.modules]))"
+    )
+    assert r == []
+    r = _python(
+        "import json, sys\n"
+        "from meshes.scene import gmsh_model\n"
+        "print(json.dumps([m for m in ('dolfinx', 'mpi4py') if m in sys.modules]))"
+    )
+    assert r == []
+
+
+def _lines():
+    import numpy as np
+
+    x = np.linspace(-1, 1, 200)
+    return {"p_n computed": (x, 1 - x**2, "."), "Hertz": (x, np.sqrt(1 - x**2), "-")}
+
+
+def test_plot_worker_draws_the_same_png(tmp_path):
+    """The worker's PNG is byte for byte the in-process one; it is used once, then plot_lines
+    draws in-process again."""
+    from dolfinx_forms import output, plot_worker
+
+    plot_worker.draw(tmp_path / "here.png", _lines(), "t", "x", "y", (0.5,))
+    output._worker = worker = plot_worker.Worker()  # start_plot_worker: none on a busy machine
+    output.plot_lines(tmp_path / "worker.png", _lines(), "t", "x", "y", (0.5,))
+    assert output._worker is None and worker.proc.returncode == 0
+    assert (tmp_path / "worker.png").read_bytes() == (tmp_path / "here.png").read_bytes()
+    output.plot_lines(tmp_path / "again.png", _lines(), "t", "x", "y", (0.5,))
+    assert (tmp_path / "again.png").read_bytes() == (tmp_path / "here.png").read_bytes()
+
+
+def test_plot_worker_errors_and_unused(tmp_path):
+    """An error in the worker is raised in the caller; an unused worker is ended."""
+    import pytest
+
+    from dolfinx_forms import output, plot_worker
+
+    output._worker = plot_worker.Worker()
+    with pytest.raises(RuntimeError, match="plot worker"):
+        output.plot_lines(tmp_path / "missing" / "x.png", _lines())
+    output._worker = worker = plot_worker.Worker()
+    output.stop_plot_worker()
+    assert worker.proc.poll() is not None and output._worker is None
+
+
+def test_plot_worker_only_when_a_core_is_idle(monkeypatch):
+    from dolfinx_forms import plot_worker
+
+    monkeypatch.setattr(plot_worker.os, "getloadavg", lambda: (64.0, 64.0, 64.0))
+    assert plot_worker.start() is None
+    monkeypatch.setattr(plot_worker.os, "getloadavg", lambda: (0.0, 0.0, 0.0))
+    worker = plot_worker.start()
+    assert worker is not None
+    worker.close()
+
+
+def test_exit_process_status():
+    """cli.exit_process: the status reaches the shell (0, 1)."""
+    for status in (0, 1):
+        p = subprocess.run(
+            [sys.executable, "-c", f"from dolfinx_forms import cli; cli.exit_process({status})"],
+            env=dict(os.environ, PYTHONPATH=str(ROOT)),
+        )
+        assert p.returncode == status
