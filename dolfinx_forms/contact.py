@@ -102,15 +102,16 @@ def chain_arcs(pieces, tol):
     """Arc length along the chains of (m, 2, 2) `pieces` (`surface_chains`): per piece the arc
     length at its start, that start point (a piece may run against its chain), its chain, and
     the chains' lengths."""
+    size = np.linalg.norm(pieces[:, 1] - pieces[:, 0], axis=1)
     arc, start = np.zeros(len(pieces)), np.zeros((len(pieces), 2))
     chain_of, lengths = np.zeros(len(pieces), np.int64), []
     for c, chain in enumerate(surface_chains(pieces, tol)):
-        s = 0.0
-        for k, rev in chain:
-            a, b = pieces[k][::-1] if rev else pieces[k]
-            arc[k], start[k], chain_of[k] = s, a, c
-            s += np.linalg.norm(b - a)
-        lengths.append(s)
+        k = np.array([k for k, _ in chain], np.int64)
+        rev = np.array([r for _, r in chain], bool)
+        arc[k] = np.r_[0.0, np.cumsum(size[k])[:-1]]
+        start[k] = np.where(rev[:, None], pieces[k, 1], pieces[k, 0])
+        chain_of[k] = c
+        lengths.append(size[k].sum())
     return arc, start, chain_of, np.array(lengths)
 
 
@@ -164,19 +165,21 @@ def split_segments(pieces, cells, piece, t, tol):
 def label_breaks(pieces, labels, tol, iterations=36):
     """Where the integer labels of the points of the (m, 2, 2) `pieces` change along them
     (`labels(points)` -> (n, k), e.g. the cells that hold the closest points on each body):
-    the first change along each piece, by bisection to 2^-iterations of it (below tol for
-    pieces up to ~6 h / grid_refine long at tol = 1e-10 dx). Labels are read
-    tol (a length: `split_segments` makes no piece shorter) inside the ends, so a change
-    closer to an end is ignored. One change per piece and round: call it again on the split
-    pieces for more. Returns (piece, t) pairs for `split_segments`."""
+    for each label that differs between a piece's ends, its first change, by bisection to
+    2^-iterations of the piece (below tol for pieces up to ~6 h / grid_refine long at
+    tol = 1e-10 dx). Labels are read tol (a length, at least `split_segments`' shortest piece;
+    above the closest points' own error, or that error reads as a change at every cut made)
+    inside the ends, so a change closer to an end is ignored. One change per label and round:
+    call it again on the split pieces for more. Returns (piece, t) pairs for
+    `split_segments`."""
     a, b = pieces[:, 0], pieces[:, 1]
     inset = np.minimum(tol / np.maximum(np.linalg.norm(b - a, axis=1), 1e-300), 0.25)[:, None]
     la, lb = labels(a + inset * (b - a)), labels(b - inset * (b - a))
-    k = np.flatnonzero(np.any(la != lb, axis=1))
+    k, col = np.nonzero(la != lb)  # one bisection per (piece, label) that changes
     lo, hi = inset[k, 0], 1.0 - inset[k, 0]
     for _ in range(iterations):
         mid = 0.5 * (lo + hi)
-        same = np.all(labels(a[k] + mid[:, None] * (b[k] - a[k])) == la[k], axis=1)
+        same = labels(a[k] + mid[:, None] * (b[k] - a[k]))[np.arange(len(k)), col] == la[k, col]
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
     return k, 0.5 * (lo + hi)
 
@@ -379,7 +382,11 @@ class GridLocator:
     def cell_label(self, points, max_distance):
         """An integer per point that changes wherever its cell does: its grid cell's index (a
         point in an inactive grid cell goes to a neighbour's cell, inside that grid cell)."""
-        i, j = self._index(np.asarray(points, float)[:, :2])
+        # a closest point on a grid line (a block's face) goes to the cell below it whatever its
+        # round-off: a face along a line would otherwise change label at every point
+        p = np.asarray(points, float)[:, :2]
+        tie = 1e-9 * max(self.xl[-1] - self.xl[0], self.yl[-1] - self.yl[0])
+        i, j = self._index(p - tie)
         return i * self.table.shape[1] + j
 
     def locate(self, points, max_distance):
@@ -548,7 +555,7 @@ def pair_geometry(
             return np.stack(cells + [past[0] & past[1]], axis=1)
 
         for _ in range(6):  # a piece (h / grid_refine) rarely holds more than one change
-            piece, t = label_breaks(segs, labels, tol)
+            piece, t = label_breaks(segs, labels, 100 * tol)
             if len(piece) == 0:
                 break
             segs, cells = split_segments(segs, cells, piece, t, tol)
