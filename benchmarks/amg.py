@@ -45,6 +45,7 @@ import numpy as np
 
 from scaling import _hertz_demo, child, write_atomic  # the script's folder is on sys.path
 from work_precision import git_head
+from work_precision import write_atomic as replace_atomic
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -294,8 +295,6 @@ def write_csv(rows, path):
 
 
 def plot(hertz, cuts, path):
-    import os
-
     import matplotlib
 
     matplotlib.use("Agg")
@@ -340,10 +339,7 @@ def plot(hertz, cuts, path):
     for a in ax:
         a.grid(True, which="both", lw=0.3)
     fig.tight_layout()
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".png")
-    os.close(fd)
-    fig.savefig(tmp, dpi=110)
-    os.replace(tmp, path)
+    replace_atomic(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
 
 
 def main(argv=None):

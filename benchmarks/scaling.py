@@ -29,6 +29,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from work_precision import write_atomic as replace_atomic  # the script's folder is on sys.path
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -173,11 +175,9 @@ def _hertz_demo():
 
 
 def write_atomic(path, text):
+    """`text` into `path` in one rename (work_precision.write_atomic)."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    with os.fdopen(fd, "w") as f:
-        f.write(text)
-    os.replace(tmp, path)
+    replace_atomic(path, lambda tmp: Path(tmp).write_text(text))
 
 
 def plot(rows, path):
@@ -207,10 +207,7 @@ def plot(rows, path):
         a.legend(fontsize=8)
         a.grid(True, which="both", lw=0.3)
     fig.tight_layout()
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".png")
-    os.close(fd)
-    fig.savefig(tmp, dpi=120)
-    os.replace(tmp, path)
+    replace_atomic(path, lambda tmp: fig.savefig(tmp, dpi=120, format="png"))
 
 
 def main(argv=None):

@@ -102,15 +102,14 @@ def summarise(runs, names):
 
 
 def write_atomic(path, write):
-    """write(file object) into a temporary file beside `path`, then os.replace."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    try:
-        with os.fdopen(fd, "wb") as f:
+    """write(binary file object) into `path` in one rename (work_precision.write_atomic)."""
+    from work_precision import write_atomic as replace_atomic
+
+    def writer(tmp):
+        with open(tmp, "wb") as f:
             write(f)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+
+    replace_atomic(path, writer)
 
 
 def plot(path, summary, ratios, n):
