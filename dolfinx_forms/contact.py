@@ -554,11 +554,16 @@ def pair_geometry(
             past = [beyond_end(points, p, n, 1e-9 * dx) for p in proj]
             return np.stack(cells + [past[0] & past[1]], axis=1)
 
-        for _ in range(6):  # a piece (h / grid_refine) rarely holds more than one change
-            piece, t = label_breaks(segs, labels, 100 * tol)
+        # a piece (h / grid_refine) rarely holds more than one change; after the first round
+        # only the sub-pieces of the pieces just split can hold one (the others had none)
+        check = np.ones(len(segs), bool)
+        for _ in range(6):
+            piece, t = label_breaks(segs[check], labels, 100 * tol)
             if len(piece) == 0:
                 break
-            segs, cells = split_segments(segs, cells, piece, t, tol)
+            piece = np.flatnonzero(check)[piece]
+            segs, parent = split_segments(segs, np.arange(len(segs)), piece, t, tol)
+            cells, check = cells[parent], np.isin(parent, piece)
         # where both bodies end (the corners of two blocks), so does Gamma_c: the closing
         # level set's sign, which clipped it, is off by its reinitialisation error (~dx / 40)
         if len(segs):
