@@ -13,8 +13,9 @@ them) and returns, on every rank, one line per failed check:
   contact spots of one pair (rough grains) are further apart than h, or are one gap.
 
 The demos put them in metrics.json (`solver.warnings`) and on the console, with the largest
-penetration (`penetration`): point-wise, and as the law points' weighted mean gap, which is
-what the augmented enforcement's multipliers constrain (a mortar method's weak
+penetration (`penetration`): point-wise, and as the law points' (with traction "points", the
+multiplier nodes') weighted mean gap, which is what the augmented enforcement's multipliers
+constrain (a mortar method's weak
 non-penetration: its fixed point has zero mean gap at every active node, the point-wise gap
 between nodes is the P1 trace's discretisation error).
 """
@@ -85,12 +86,16 @@ def penetration(problem):
     from mpi4py import MPI
 
     pts = law = 0.0
-    for s in problem.contact.committed:
+    for g, s in zip(problem.contact.pairs, problem.contact.committed):
         if s is None:
             continue
         if np.any(s["state"] > 0):
             pts = max(pts, -float(s["g_n"][s["state"] > 0].min()))
-        if np.any(s["law_state"] > 0):
+        if g.mult_nodes is not None and not g.law_at_nodes:
+            # traction "points": the multiplier nodes carrying pressure, their mean gaps
+            gbar, active = g.project(s["g_n"])[0], g.project(s["tau_n"])[0] < 0
+            law = max(law, -float(gbar[active].min())) if np.any(active) else law
+        elif np.any(s["law_state"] > 0):
             law = max(law, -float(s["law_g_n"][s["law_state"] > 0].min()))
     h = problem.scene.h_contact
     pts, law = (problem.comm.allreduce(max(v, 0.0), op=MPI.MAX) for v in (pts, law))

@@ -55,17 +55,40 @@ class PairGeometry:
     # every point carries its own traction
     mult_nodes: np.ndarray = None
     mult_weights: np.ndarray = None
+    # where the law acts with multiplier nodes: "nodes" (on their weighted mean gaps) or
+    # "points" (at each point, the multipliers interpolated there: `pair_geometry`'s traction)
+    traction: str = "nodes"
+
+    @property
+    def law_at_nodes(self):
+        return self.mult_nodes is not None and self.traction == "nodes"
 
     @property
     def num_law_points(self):
-        return len(self.weights) if self.mult_nodes is None else int(self.mult_nodes.max()) + 1
+        return int(self.mult_nodes.max()) + 1 if self.law_at_nodes else len(self.weights)
+
+    @property
+    def num_nodes(self):
+        return 0 if self.mult_nodes is None else int(self.mult_nodes.max()) + 1
+
+    def interpolate(self, node_values):
+        """Values at the multiplier nodes interpolated to the points."""
+        v = np.asarray(node_values)[np.maximum(self.mult_nodes, 0)]
+        return np.sum(np.where(self.mult_nodes >= 0, self.mult_weights * v, 0.0), axis=1)
+
+    def project(self, point_values):
+        """Point values projected on the multiplier nodes: their weighted means over each
+        node's hat, sum_p w_p psi_p v_p / sum_p w_p psi_p (the lumped L2 projection), and those
+        weights W (0 for none)."""
+        wp = np.where(self.mult_nodes >= 0, self.weights[:, None] * self.mult_weights, 0.0)
+        idx = np.maximum(self.mult_nodes, 0).ravel()
+        W = np.bincount(idx, wp.ravel(), self.num_nodes)
+        F = np.bincount(idx, (wp * np.asarray(point_values)[:, None]).ravel(), self.num_nodes)
+        return F / np.maximum(W, 1e-300), W
 
     def to_points(self, law_values):
-        """Values at the law points (multiplier nodes) interpolated to the points."""
-        if self.mult_nodes is None:
-            return law_values
-        v = np.asarray(law_values)[np.maximum(self.mult_nodes, 0)]
-        return np.sum(np.where(self.mult_nodes >= 0, self.mult_weights * v, 0.0), axis=1)
+        """Values at the law points (multiplier nodes or points) at the points."""
+        return self.interpolate(law_values) if self.law_at_nodes else law_values
 
 
 def surface_chains(pieces, tol):
@@ -442,6 +465,7 @@ def pair_geometry(
     lattice_origin=None,
     multipliers=None,
     multiplier_length=None,
+    traction="nodes",
 ):
     """Contact quadrature of `pair` (indices into scene.bodies), or of body pair[0] and the
     rigid `obstacle` (pair[1] ignored): side j then has no dofs (nodes_j = 0).
@@ -454,10 +478,16 @@ def pair_geometry(
     level set for a body without one) or "levelset" (eq 25 on the grid level sets for both).
     multipliers: None (a traction per point), "P0" or "P1": multiplier nodes along Gamma_c
     about multiplier_length (default h) apart (`multiplier_nodes`).
+    traction (with multipliers): "nodes", the law acts on each node's weighted mean gap and the
+    points carry the nodes' tractions interpolated; or "points", the law acts at each point
+    and the nodes only carry the multipliers (`contact_set`: the augmented Lagrangian's
+    P1 multipliers with a point-wise traction).
     Returns None when the pair cannot touch (disjoint inflated boxes or empty Gamma_c).
     """
     if projection not in ("auto", "levelset"):
         raise ValueError(f"projection must be 'auto' or 'levelset', got {projection!r}")
+    if traction not in ("nodes", "points"):
+        raise ValueError(f"traction must be 'nodes' or 'points', got {traction!r}")
     i, j = pair
     bi = scene.bodies[i]
     bj = scene.bodies[j] if obstacle is None else obstacle
@@ -607,7 +637,7 @@ def pair_geometry(
     q = _cpp.ContactQuadrature(
         s["weights"], normals, tangents, g_n0, sides[0][0], sides[1][0], sides[0][1], sides[1][1]
     )
-    if mult[0] is not None:
+    if mult[0] is not None and traction == "nodes":
         q.set_multiplier_nodes(*mult)
     return PairGeometry(
         pair,
@@ -623,4 +653,5 @@ def pair_geometry(
         box,
         obstacle,
         *mult,
+        traction,
     )

@@ -8,7 +8,8 @@ committed values, each Newton iteration sets its trial values, an accepted step 
 them and a rejected one restores them exactly.
 
 The law acts at the *law points*: the pair's multiplier nodes (`contact.multiplier_nodes`,
-each with the weighted mean gap of its points), or the points themselves without them.
+each with the weighted mean gap of its points; traction "nodes"), or the points themselves
+(without multiplier nodes, or with traction "points").
 
 Enforcement: "penalty" (eqs 8, 12: the answer depends on eps) or "augmented" (augmented
 Lagrangian, Uzawa's outer loop of seed 003): multipliers lambda_n, lambda_t per law point enter
@@ -18,6 +19,19 @@ each converged Newton solve `newton.augmented_loop` sets lambda <- tau, until th
 stop changing. The fixed point has zero mean gap at every active node and zero slip over the
 step at every sticking one, whatever eps: eps sets the speed of the loop, not the answer. The
 multipliers of a step start from the committed tractions; a rejected step restores them.
+
+With traction "points" the multipliers are P1 along Gamma_c but the law acts at every point
+with them interpolated there, lambda_h(x_p): tau_n,p = min(0, lambda_h(x_p) + g_n,p / eps_n),
+and Uzawa's update is the lumped L2 projection lambda <- Pi tau (`PairGeometry.project`). At the
+fixed point a node whose hat lies in contact has the weighted mean gap
+eps_n ((M_L - M) lambda)_i / W_i (M, M_L: the consistent and lumped mass of the hats), a
+stabilised mortar constraint of size eps_n h^2 lambda'' (Hertz: 7.5e-4 h), while the traction
+keeps the point-wise shape of the gap between the nodes: the contact edge and the stick/slip
+boundary fall between nodes as with the penalty (Hertz at h = a/20: p(x) 0.91 % body-fitted,
+1.19 % cut, against 2.43 % and 3.46 % with traction "nodes"). eps_n is then part of the
+discretisation (`solver.POINTWISE_EPS0`), and the user's eps0 only relaxes the Uzawa step
+(`relaxation` <= 1). The consistent projection M^-1 instead (a zero mean gap) did not converge:
+the clipped traction at the edge nodes has no such fixed point.
 """
 
 import numpy as np
@@ -61,10 +75,15 @@ class ContactSet:
         multipliers=None,
         multiplier_length=None,
         enforcement="penalty",
+        traction="nodes",
+        relaxation=1.0,
     ):
         if enforcement not in ("penalty", "augmented"):
             raise ValueError(f"enforcement must be 'penalty' or 'augmented', got {enforcement!r}")
+        if not 0.0 < relaxation <= 1.0:
+            raise ValueError(f"relaxation must be in (0, 1], got {relaxation!r}")
         self.enforcement = enforcement
+        self.relaxation = float(relaxation)
         self.eps_n, self.eps_t, self.mu = float(eps_n), float(eps_t), float(mu)
         self.pairs = []
         self.obstacles = list(obstacles)
@@ -80,6 +99,7 @@ class ContactSet:
             lattice_origin=lattice_origin,
             multipliers=multipliers,
             multiplier_length=multiplier_length,
+            traction=traction,
         )
         candidates = [(tuple(pair), None) for pair in scene.pairs] + [
             ((i, -1), ob)
@@ -100,6 +120,8 @@ class ContactSet:
         # nodes, or the points): `PairGeometry.num_law_points`
         self.history = [_cpp.FrictionHistory(g.num_law_points, 1) for g in self.pairs]
         self.slip_start = [np.zeros(g.num_law_points) for g in self.pairs]
+        # plastic slip since friction was switched on, summed over accepted steps
+        self.plastic = [np.zeros(g.num_law_points) for g in self.pairs]
         self.last = [None] * len(self.pairs)  # kernel output of the last evaluation
         self.committed = [None] * len(self.pairs)  # point states of the last accepted step
         # augmented Lagrangian multipliers (per law point): the step's
@@ -227,10 +249,16 @@ class ContactSet:
         return x
 
     def tractions(self):
-        """The tractions of the last evaluation, laid out as `multipliers` (Uzawa's T)."""
-        parts = [s["law_tau_n"] for s in self.last] + (
-            [s["law_tau_t"] for s in self.last] if self.mu > 0 else []
-        )
+        """The tractions of the last evaluation, laid out as `multipliers` (Uzawa's T); with
+        traction "points" projected on the multiplier nodes and interpolated back."""
+
+        def law(g, tau):
+            return (
+                tau if g.mult_nodes is None or g.law_at_nodes else g.interpolate(g.project(tau)[0])
+            )
+
+        keys = ["law_tau_n"] + (["law_tau_t"] if self.mu > 0 else [])
+        parts = [law(g, s[key]) for key in keys for g, s in zip(self.pairs, self.last)]
         return np.concatenate(parts) if parts else np.zeros(0)
 
     def assemble(self, u, b, A=None, fd=False, fd_step=1e-9, closed_gap=0.0):
@@ -244,6 +272,9 @@ class ContactSet:
                 self.history[k].trial = s["gtp_trial"]
 
     def commit(self):
+        if self.mu > 0:  # the step's plastic slip: the return mapping's, from the slip it read
+            for k, h in enumerate(self.history):
+                self.plastic[k] = self.plastic[k] + (np.asarray(h.trial) - self._slip_read(k))
         # Keep the accepted step's point states: re-evaluating them with the committed slip
         # would put the slipped points exactly on the cone, where stick/slip is a coin toss.
         self.committed = [dict(s) for s in self.last]
@@ -269,6 +300,7 @@ class ContactSet:
                     self.committed[k]["law_tau_t"] = np.zeros(g.num_law_points)
                     self.committed[k]["tau_t"] = np.zeros(len(g.weights))
                 self.slip_start[k] = h.committed
+                self.plastic[k] = np.zeros(g.num_law_points)
         self.mu = mu
 
     def signature(self):
@@ -291,7 +323,10 @@ class ContactSet:
             # plastic slip accumulated since friction was switched on (mu = 0: all of g_t);
             # augmented: the whole tangential gap (g_t = g_t^p + eps_t tau_t) since then, as
             # the converged stick is exact
-            if self.mu > 0:
+            # traction "points": the plastic slip (the stick between the nodes is not exact)
+            if self.mu > 0 and g.mult_nodes is not None and not g.law_at_nodes:
+                slip = self.plastic[k]
+            elif self.mu > 0:
                 slip = self.history[k].committed - self.slip_start[k]
                 if self.augmented:
                     slip = slip + self.eps_t * s["law_tau_t"]

@@ -148,11 +148,13 @@ def augmented_loop(problem, lam, residuals, depth=20):
     """The augmented Lagrangian's outer loop at load level lam, after a converged Newton solve:
     the fixed point lambda = T(lambda), T(lambda) = the tractions of the solution with
     multipliers lambda (Uzawa's update, seed 003), accelerated by Anderson mixing of the last
-    `depth` iterates (Walker & Ni 2011; restarted when the update grows). Stops when no
+    `depth` iterates (Walker & Ni 2011; restarted when the update grows), its steps relaxed by
+    the contact set's `relaxation`. Stops when no
     multiplier changes by more than al_rtol of the largest traction and no gap by more than
     al_gtol h. Appends the inner Newton residuals to `residuals`.
     Returns (ok, augmentations, why)."""
     cs, comm, opts = problem.contact, problem.comm, problem.newton
+    rho = cs.relaxation  # the mixing parameter of Anderson's update
     # lambda - tau = gap / eps at an active law point: the gap tolerance in traction units
     gap_tol = opts.al_gtol * problem.scene.h_contact / max(cs.eps_n, cs.eps_t)
     X, F = [], []
@@ -174,14 +176,14 @@ def augmented_loop(problem, lam, residuals, depth=20):
         X.append(x.copy())
         F.append(f.copy())
         X, F = X[-(depth + 1) :], F[-(depth + 1) :]
-        x = x + f  # Uzawa: lambda <- tau
+        x = x + rho * f  # Uzawa: lambda <- tau (relaxed)
         if len(F) > 1:
             dF = np.array([F[i + 1] - F[i] for i in range(len(F) - 1)])
             dX = np.array([X[i + 1] - X[i] for i in range(len(X) - 1)])
             G = comm.allreduce(dF @ dF.T, MPI.SUM)
             rhs = comm.allreduce(dF @ f, MPI.SUM)
             gamma = np.linalg.lstsq(G + 1e-14 * np.trace(G) * np.eye(len(G)), rhs, rcond=None)[0]
-            x = cs.admissible(x - (dX + dF).T @ gamma)
+            x = cs.admissible(x - (dX + rho * dF).T @ gamma)
         cs.set_multipliers(x)
         ok, more, why = newton(problem, lam, residuals[0])
         residuals += more
