@@ -108,7 +108,20 @@ def test_mindlin_independent_of_eps0(tmp_path):
         a, b = (r["results"][key] for r in runs)
         assert abs(a - b) <= 1e-5 * abs(a), key
     c, c_exact = runs[0]["results"]["stick_half_width"], runs[0]["analytic"]["stick_half_width"]
-    assert abs(c - c_exact) <= 0.1 * c_exact  # one segment (h = a/10) of Cattaneo-Mindlin's c
+    # the point-wise traction places the stick/slip boundary between the nodes (1.8 % seen,
+    # penalty 0.8 %, traction "nodes" about one node spacing, h = 14 % of c)
+    assert abs(c - c_exact) <= 0.04 * c_exact
+
+
+@pytest.mark.parametrize("disc,bound", [("conforming", 0.0100), ("cut", 0.0130)])
+def test_hertz_accuracy_at_a_over_20(tmp_path, disc, bound):
+    """Issue 11's target at the demo's default h = a/20: p(x) no worse than the penalty at its
+    best eps0 (1.16 % body-fitted, 1.85 % cut); 0.914 % and 1.190 % seen. The P1 multipliers
+    alone cannot: their best L2 approximation of the Hertz pressure is 1.03-1.11 % at h
+    (benchmarks/multiplier_bound.py), and traction "nodes" gives 2.43 % / 3.46 %."""
+    m, _ = run("hertz.py", tmp_path / disc, "--enforcement", "augmented", "--discretization", disc)
+    assert m["results"]["pressure_rel_l2_error"] <= bound
+    assert m["solver"]["warnings"] == []
 
 
 def test_traction_at_nodes_zero_mean_gap():
