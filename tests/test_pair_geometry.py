@@ -179,3 +179,31 @@ def test_beyond_end_flags_points_past_a_corner_only():
     pts = np.array([[-0.3, 0.0], [-1e-9, 0.0], [0.2, 0.0], [0.5, 0.01], [0.7, 0.0]])
     closest = np.array([[0.0, 0.0], [0.0, 0.0], [0.2, -0.05], [0.49, 0.0], [0.7, 0.0]])
     assert beyond_end(pts, closest, n, 1e-12).tolist() == [True, True, False, False, False]
+
+
+def test_point_wise_traction_keeps_the_points_as_law_points(hertz):
+    """traction="points": the same points and multiplier nodes as "nodes", but the law acts at
+    the points (the kernel gets no nodes); `project` is the hats' weighted mean (the lumped L2
+    projection): exact for constants, and for linear data at nodes whose hat lies wholly on
+    one chain of equal elements; `interpolate` is the P1 interpolant."""
+    scene, V = hertz
+    gn = pair_geometry(V, scene, (0, 1), 0.2, multipliers="P1", traction="nodes")
+    gp = pair_geometry(V, scene, (0, 1), 0.2, multipliers="P1", traction="points")
+    np.testing.assert_array_equal(gp.points, gn.points)
+    np.testing.assert_array_equal(gp.mult_nodes, gn.mult_nodes)
+    assert gn.law_at_nodes and not gp.law_at_nodes
+    assert gn.num_law_points == gn.num_nodes < len(gn.weights) == gp.num_law_points
+    assert gp.quadrature.num_law_points == len(gp.weights)  # the kernel's law points
+    x = gp.points[:, 0]
+    one, W = gp.project(np.ones_like(x))
+    np.testing.assert_allclose(one, 1.0, rtol=1e-13)
+    np.testing.assert_allclose(W.sum(), gp.weights.sum(), rtol=1e-13)
+    node_x, _ = gp.project(x)
+    lin = gp.interpolate(node_x)
+    inner = (x > x.min() + 0.3) & (x < x.max() - 0.3)  # away from the chain's end elements
+    # x is linear in Gamma_c's arc length to ~1e-5 here (it curves as x^2 / 4R)
+    np.testing.assert_allclose(lin[inner], x[inner], atol=1e-4)
+    assert np.abs(gp.interpolate(gp.project(x * x)[0]) - x * x)[inner].max() > 1e-4
+    np.testing.assert_array_equal(gp.to_points(x), x)
+    with pytest.raises(ValueError, match="traction"):
+        pair_geometry(V, scene, (0, 1), 0.2, multipliers="P1", traction="both")
