@@ -48,7 +48,12 @@ COLUMNS = ["step", "displacement", "force_top", "force_bottom", "half_width_top"
 
 def parse(argv):
     p = cli.demo_parser(
-        "brazilian_disc.py", __doc__, "results/brazilian_disc", OPTIONS, discretization=False
+        "brazilian_disc.py",
+        __doc__,
+        "results/brazilian_disc",
+        OPTIONS,
+        discretization=False,
+        enforcement=("penalty",),  # the multi-step MPM: mpm.py
     )
     a = p.parse_args(argv)
     if not a.h <= a.R / 5:

@@ -51,7 +51,12 @@ CLEARANCE = 0.25  # mm between a plate's end and the perpendicular plate's inner
 
 def parse(argv):
     p = cli.demo_parser(
-        "four_grains.py", __doc__, "results/four_grains", OPTIONS, discretization=False
+        "four_grains.py",
+        __doc__,
+        "results/four_grains",
+        OPTIONS,
+        discretization=False,
+        enforcement=("penalty",),  # the multi-step MPM: mpm.py
     )
     a = p.parse_args(argv)
     if not 0 <= a.seed < 2**31:

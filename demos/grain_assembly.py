@@ -49,7 +49,12 @@ COLUMNS = ["step", "phase"] + [f"{p}_{c}" for p in PLATES for c in ("normal", "t
 
 def parse(argv):
     p = cli.demo_parser(
-        "grain_assembly.py", __doc__, "results/grain_assembly", OPTIONS, discretization=False
+        "grain_assembly.py",
+        __doc__,
+        "results/grain_assembly",
+        OPTIONS,
+        discretization=False,
+        enforcement=("penalty",),  # the multi-step MPM: mpm.py
     )
     a = p.parse_args(argv)
     if not 5 <= a.radius / a.h <= 100:

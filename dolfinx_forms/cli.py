@@ -367,11 +367,21 @@ def petsc_trial(opts, defaults=None):
     return ierr, unread
 
 
-def demo_parser(prog, doc, out, options=(), discretization=True, petsc=True, cells=None):
+def demo_parser(
+    prog,
+    doc,
+    out,
+    options=(),
+    discretization=True,
+    petsc=True,
+    cells=None,
+    enforcement=("penalty", "augmented"),
+):
     """A demo's parser: the description is the first paragraph of `doc`; --out (default `out`)
     and --force, --discretization and --ghost-penalty (add_discretization), the `options`
     table (add_options), --quads/--triangles (add_cells, with cells = (quads by default,
-    help of --quads, help of --triangles)), --petsc (add_petsc)."""
+    help of --quads, help of --triangles)), --enforcement with the `enforcement` choices,
+    --linear-solver, --petsc (add_petsc)."""
     p = DemoParser(prog=prog, description=doc.split("\n\n")[0])
     p.add_out(out)
     if discretization:
@@ -380,7 +390,7 @@ def demo_parser(prog, doc, out, options=(), discretization=True, petsc=True, cel
     if cells is not None:
         add_cells(p, *cells)
     if petsc:
-        add_enforcement(p)
+        add_enforcement(p, enforcement)
         add_linear_solver(p)
         add_petsc(p)
     return p
@@ -408,15 +418,20 @@ def check_scale(parser, args, size, what, max_cells=2000, displacement=True):
 AUGMENTED_EPS0 = 1e-2
 
 
-def add_enforcement(parser):
-    """--enforcement: penalty (eqs 8, 12) or augmented Lagrangian (Uzawa, seed 003)."""
+def add_enforcement(parser, choices=("penalty", "augmented")):
+    """--enforcement: penalty (eqs 8, 12) or augmented Lagrangian (Uzawa, seed 003); a demo of
+    the multi-step MPM offers the penalty only (`mpm.ImplicitMPM` refuses the other)."""
     parser.add_argument(
         "--enforcement",
-        choices=["penalty", "augmented"],
+        choices=list(choices),
         default="penalty",
-        help="contact enforcement: penalty (the answer depends on --eps0) or augmented "
-        "(augmented Lagrangian, P1 multipliers along the contact: --eps0 sets only the "
-        f"loop's speed, default {AUGMENTED_EPS0:g} with it)",
+        help=(
+            "contact enforcement: penalty (the answer depends on --eps0) or augmented "
+            "(augmented Lagrangian, P1 multipliers along the contact: --eps0 sets only the "
+            f"loop's speed, default {AUGMENTED_EPS0:g} with it)"
+            if "augmented" in choices
+            else "contact enforcement: the multi-step MPM runs the penalty only"
+        ),
     )
 
 
