@@ -104,13 +104,13 @@ class Condensed:
         K0 = problem.K.copy()
         K0.zeroRows(problem.bc_global, diag=1.0)
         self.IS = PETSc.IS().createGeneral(np.asarray(dofs, dtype=np.int32), comm=problem.comm)
-        self.F, self.S0 = _cpp.schur_factor(K0, self.IS)
-        self.K0cc = _dense(K0.createSubMatrix(self.IS, self.IS))
+        self.F, S0 = _cpp.schur_factor(K0, self.IS)
         # S = S0 + (J_cc - K0_cc) is formed in one buffer from J_cc's sparse rows: its
         # conversion to a dense Mat and fresh m x m arrays cost 7 ms and 4-6 ms of page faults
         # per update at m = 456 (cut Hertz a/20) on these machines, against 0.3 ms
-        self.base = self.S0 - self.K0cc
-        self.S = np.empty_like(self.S0)
+        # (only base and S are kept: two m x m arrays, 230 MB each at m = 5340)
+        self.base = S0 - _dense(K0.createSubMatrix(self.IS, self.IS))
+        self.S = np.empty_like(S0)
         self.t_factor = time.perf_counter() - t0
         self.num_dofs = len(dofs)
         self.factorisations = 1  # sparse, once
@@ -134,7 +134,7 @@ class Condensed:
             self.full = Factorised(self.problem, self.petsc_options)
             self.full.factorisations = self.factorisations
             self.name = f"factorised (condensed: {self.num_dofs} contact dofs cost more)"
-            self.F = self.S0 = self.K0cc = self.S = self.base = None
+            self.F = self.S = self.base = None
             return self.full.setup(J, None)
 
     def solve(self, b, x):
