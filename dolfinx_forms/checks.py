@@ -91,7 +91,7 @@ def penetration(problem):
             continue
         if np.any(s["state"] > 0):
             pts = max(pts, -float(s["g_n"][s["state"] > 0].min()))
-        if g.mult_nodes is not None and not g.law_at_nodes:
+        if g.law_at_points_with_nodes:
             # traction "points": the multiplier nodes carrying pressure, their mean gaps
             gbar, active = g.project(s["g_n"])[0], g.project(s["tau_n"])[0] < 0
             law = max(law, -float(gbar[active].min())) if np.any(active) else law

@@ -64,6 +64,11 @@ class PairGeometry:
         return self.mult_nodes is not None and self.traction == "nodes"
 
     @property
+    def law_at_points_with_nodes(self):
+        """Multiplier nodes that carry the multipliers while the law acts at the points."""
+        return self.mult_nodes is not None and self.traction == "points"
+
+    @property
     def num_law_points(self):
         return int(self.mult_nodes.max()) + 1 if self.law_at_nodes else len(self.weights)
 

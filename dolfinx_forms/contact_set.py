@@ -253,9 +253,7 @@ class ContactSet:
         traction "points" projected on the multiplier nodes and interpolated back."""
 
         def law(g, tau):
-            return (
-                tau if g.mult_nodes is None or g.law_at_nodes else g.interpolate(g.project(tau)[0])
-            )
+            return g.interpolate(g.project(tau)[0]) if g.law_at_points_with_nodes else tau
 
         keys = ["law_tau_n"] + (["law_tau_t"] if self.mu > 0 else [])
         parts = [law(g, s[key]) for key in keys for g, s in zip(self.pairs, self.last)]
@@ -324,7 +322,7 @@ class ContactSet:
             # augmented: the whole tangential gap (g_t = g_t^p + eps_t tau_t) since then, as
             # the converged stick is exact
             # traction "points": the plastic slip (the stick between the nodes is not exact)
-            if self.mu > 0 and g.mult_nodes is not None and not g.law_at_nodes:
+            if self.mu > 0 and g.law_at_points_with_nodes:
                 slip = self.plastic[k]
             elif self.mu > 0:
                 slip = self.history[k].committed - self.slip_start[k]

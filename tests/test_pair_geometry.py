@@ -191,7 +191,7 @@ def test_point_wise_traction_keeps_the_points_as_law_points(hertz):
     gp = pair_geometry(V, scene, (0, 1), 0.2, multipliers="P1", traction="points")
     np.testing.assert_array_equal(gp.points, gn.points)
     np.testing.assert_array_equal(gp.mult_nodes, gn.mult_nodes)
-    assert gn.law_at_nodes and not gp.law_at_nodes
+    assert gn.law_at_nodes and not gp.law_at_nodes and gp.law_at_points_with_nodes
     assert gn.num_law_points == gn.num_nodes < len(gn.weights) == gp.num_law_points
     assert gp.quadrature.num_law_points == len(gp.weights)  # the kernel's law points
     x = gp.points[:, 0]
