@@ -59,7 +59,12 @@ D4 = [
 
 def parse(argv):
     p = cli.demo_parser(
-        "nine_discs.py", __doc__, "results/nine_discs", OPTIONS, discretization=False
+        "nine_discs.py",
+        __doc__,
+        "results/nine_discs",
+        OPTIONS,
+        discretization=False,
+        enforcement=("penalty",),  # the multi-step MPM: mpm.py
     )
     a = p.parse_args(argv)
     k = (3 * a.R + 1.0) / a.h

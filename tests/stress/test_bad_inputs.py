@@ -103,6 +103,7 @@ CASES = [
     ("brazilian_disc", "--enforcement bogus", "--enforcement"),
     # the multi-step MPM runs the penalty only: refused, not silently a stiff penalty
     ("grain_assembly", "--enforcement augmented", "--enforcement"),
+    ("nine_discs", "--enforcement augmented", "--enforcement"),
     ("convergence_study", "--discretization CUT", "--discretization"),
     ("two_blocks", "--quads --triangles", "--triangles"),  # mutually exclusive
     # ------------------------------------------------ mesh sizes absurd for the geometry
