@@ -53,7 +53,7 @@ def parse(argv):
         "results/brazilian_disc",
         OPTIONS,
         discretization=False,
-        enforcement=("penalty",),  # the multi-step MPM: mpm.py
+        enforcement=cli.MPM_ENFORCEMENT,
     )
     a = p.parse_args(argv)
     if not a.h <= a.R / 5:

@@ -56,7 +56,7 @@ def parse(argv):
         "results/four_grains",
         OPTIONS,
         discretization=False,
-        enforcement=("penalty",),  # the multi-step MPM: mpm.py
+        enforcement=cli.MPM_ENFORCEMENT,
     )
     a = p.parse_args(argv)
     if not 0 <= a.seed < 2**31:

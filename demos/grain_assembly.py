@@ -54,7 +54,7 @@ def parse(argv):
         "results/grain_assembly",
         OPTIONS,
         discretization=False,
-        enforcement=("penalty",),  # the multi-step MPM: mpm.py
+        enforcement=cli.MPM_ENFORCEMENT,
     )
     a = p.parse_args(argv)
     if not 5 <= a.radius / a.h <= 100:

@@ -64,7 +64,7 @@ def parse(argv):
         "results/nine_discs",
         OPTIONS,
         discretization=False,
-        enforcement=("penalty",),  # the multi-step MPM: mpm.py
+        enforcement=cli.MPM_ENFORCEMENT,
     )
     a = p.parse_args(argv)
     k = (3 * a.R + 1.0) / a.h

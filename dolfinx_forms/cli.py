@@ -418,9 +418,14 @@ def check_scale(parser, args, size, what, max_cells=2000, displacement=True):
 AUGMENTED_EPS0 = 1e-2
 
 
+# the multi-step MPM runs the penalty only (`mpm.ImplicitMPM` refuses the other): its demos'
+# --enforcement choices
+MPM_ENFORCEMENT = ("penalty",)
+
+
 def add_enforcement(parser, choices=("penalty", "augmented")):
     """--enforcement: penalty (eqs 8, 12) or augmented Lagrangian (Uzawa, seed 003); a demo of
-    the multi-step MPM offers the penalty only (`mpm.ImplicitMPM` refuses the other)."""
+    the multi-step MPM offers MPM_ENFORCEMENT."""
     parser.add_argument(
         "--enforcement",
         choices=list(choices),

@@ -35,6 +35,10 @@ from . import _cpp
 from .obstacles import RigidObstacle
 
 
+# where the law acts when the pair has multiplier nodes (`PairGeometry.traction`)
+TRACTIONS = ("nodes", "points")
+
+
 @dataclass
 class PairGeometry:
     """Contact points of one body pair and what the kernel needs (see module doc)."""
@@ -491,8 +495,8 @@ def pair_geometry(
     """
     if projection not in ("auto", "levelset"):
         raise ValueError(f"projection must be 'auto' or 'levelset', got {projection!r}")
-    if traction not in ("nodes", "points"):
-        raise ValueError(f"traction must be 'nodes' or 'points', got {traction!r}")
+    if traction not in TRACTIONS:
+        raise ValueError(f"traction must be one of {TRACTIONS}, got {traction!r}")
     i, j = pair
     bi = scene.bodies[i]
     bj = scene.bodies[j] if obstacle is None else obstacle

@@ -24,6 +24,7 @@ from petsc4py import PETSc
 from .boundary import BodyForce, Dirichlet, Load, Traction, dirichlet_dofs  # noqa: F401
 from . import blas, linear
 from .bulk import BulkForms
+from .contact import TRACTIONS
 from .contact_set import STATE_NAMES, ContactSet  # noqa: F401
 from .laws import as_law
 from .newton import ContactSolverError, NewtonOptions, StepLog, load_steps  # noqa: F401
@@ -162,8 +163,8 @@ class ContactProblem:
             multipliers = "P1" if enforcement == "augmented" else None
         if traction == "default":
             traction = "points" if enforcement == "augmented" else "nodes"
-        if traction not in ("nodes", "points"):
-            raise ValueError(f"traction must be 'nodes' or 'points', got {traction!r}")
+        if traction not in TRACTIONS:
+            raise ValueError(f"traction must be one of {TRACTIONS}, got {traction!r}")
         relaxation = 1.0
         if enforcement == "augmented" and multipliers is not None and traction == "points":
             # the point-wise regularisation is part of the discretisation; eps0 sets the step
