@@ -35,6 +35,7 @@ class ForceControl:
         self.g.array[own[own < pb.n_owned]] = 1.0
         self.k = pb.K.createVecLeft()  # gradient of F (filled with the tangent)
         self.w = pb.K.createVecLeft()  # response to a unit increment of s
+        self.w_of = None  # the operator w was solved with (`linear.py`'s operator number)
         self.start = float(pb.reaction(boundary)[component])
         self.target = float(target)
         self.s = self.s_committed = self.s_start = float(pb.dirichlet[index].at(pb.lam))
@@ -61,10 +62,14 @@ class ForceControl:
         """k = J^T 1_b from the full tangent (before its Dirichlet rows are zeroed)."""
         J.multTranspose(self.sel, self.k)
 
-    def border(self, solve, du, lam):
-        """Turn the step du = -J^-1 R into the bordered step: solve(b, x) solves with J (one
-        more solve with the same factors)."""
-        solve(self.g, self.w)
+    def border(self, linear, du, lam):
+        """Turn the step du = -J^-1 R into the bordered step: linear (`linear.py`) solves
+        with J, one more solve with the same factors unless J is the one w was solved with
+        (the later iterations of a settled active set, most of an augmented Lagrangian loop)."""
+        of = linear.operator
+        if of == 0 or of != self.w_of:
+            linear.solve(self.g, self.w)
+            self.w_of = of
         dF1, dF2 = self.k.dot(du), self.k.dot(self.w)
         scale = self.k.norm() * self.w.norm()
         if abs(dF2) <= 1e-12 * scale:  # nothing couples s to F yet: keep s this iteration

@@ -24,6 +24,7 @@ dofs of the cells that hold closest points: a few hundred of 1e4-1e6).
 large body-fitted problem (`ITERATIVE_MIN_DOFS`), else Factorised.
 """
 
+import itertools
 import time
 
 import numpy as np
@@ -52,6 +53,9 @@ ITERATIVE_OPTIONS = {
 # keeps MUMPS: GAMG needs 260-1360 iterations there (the anisotropic graded grid), 5-19x slower.
 ITERATIVE_MIN_DOFS = 500_000
 KINDS = ("auto", "condensed", "factorised", "iterative")
+# a solver's `operator`: a number drawn for each operator it sets up, unique in the process (the
+# same number: the same J, whatever solver object holds it)
+_OPERATORS = itertools.count(1)
 
 
 class LinearSolverError(RuntimeError):
@@ -72,6 +76,7 @@ class Factorised:
         self.ksp.setFromOptions()
         self.key = None  # what the last factorisation was of
         self.factorisations = 0
+        self.operator = 0  # the J set up last (`_OPERATORS`; 0: none)
 
     def setup(self, J, key):
         """key: None (J changed), or a hashable description of J (the same key: same J)."""
@@ -79,6 +84,8 @@ class Factorised:
         self.ksp.getPC().setReusePreconditioner(reuse)
         self.key = key
         self.factorisations += not reuse
+        if not reuse:
+            self.operator = next(_OPERATORS)
         self.ksp.setOperators(J)
 
     def solve(self, b, x):
@@ -116,13 +123,17 @@ class Condensed:
         self.factorisations = 1  # sparse, once
         self.schur_factorisations = 0  # dense, m x m
         self.key, self.full = None, None
+        self.operator = 0  # the J set up last (`_OPERATORS`; 0: none)
 
     def setup(self, J, key):
         if self.full is not None:
-            return self.full.setup(J, key)
+            self.full.setup(J, key)
+            self.operator = self.full.operator
+            return
         if key is not None and key == self.key:
             return
         self.key = key
+        self.operator = next(_OPERATORS)
         t0 = time.perf_counter()
         ai, aj, av = J.createSubMatrix(self.IS, self.IS).getValuesCSR()
         self.S[...] = self.base
@@ -135,7 +146,9 @@ class Condensed:
             self.full.factorisations = self.factorisations
             self.name = f"factorised (condensed: {self.num_dofs} contact dofs cost more)"
             self.F = self.S = self.base = None
-            return self.full.setup(J, None)
+            self.full.setup(J, None)
+            self.full.operator = self.operator
+            return
 
     def solve(self, b, x):
         if self.full is not None:
@@ -209,6 +222,7 @@ class Iterative:
         self.lift, self.t = problem.J.createVecLeft(), problem.J.createVecLeft()
         self.J = None
         self.key = None
+        self.operator = 0  # the J set up last (`_OPERATORS`; 0: none)
         self.fresh = None  # iterations of the first solve after the last AMG set-up
         self.rebuild = True
         self.setups = 0
@@ -231,6 +245,7 @@ class Iterative:
             self.ksp.setType("gmres")
             self._true_residual()
         self.key = key
+        self.operator = next(_OPERATORS)
         J.copy(self.A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         self.A.zeroRowsColumns(self.problem.bc_global, diag=1.0)
         self._operators(self.rebuild)

@@ -1,7 +1,7 @@
 """Augmented Lagrangian enforcement (--enforcement augmented): the answer does not depend on the
 penalty.
 
-The loop (newton.augmented_loop) stops when no multiplier changes by more than 1e-9 of the
+The loop (newton.augmented_loop) stops when no multiplier changes by more than 1e-7 of the
 largest traction. The multipliers are P1 along Gamma_c; the default traction "points" applies
 the law at every contact point with them interpolated there (`contact_set`), its regularisation
 fixed by the discretisation, so eps0 only relaxes the loop. The fixed point does not depend on
@@ -156,3 +156,63 @@ def test_traction_at_nodes_zero_mean_gap():
         assert penetration(p)["law_points"] < 1e-6
         out.append(p.reaction("block_bottom")[1])
     assert abs(out[0] - out[1]) <= 1e-7 * abs(out[0])
+
+
+def _cut_hertz_force(al_first, al_eta, fresh_border=False):
+    """Cut Hertz (h = 0.25), augmented, frictionless, the load reached by force control in
+    Newton. fresh_border: the force control's border solved every iteration (no reuse)."""
+    from mpi4py import MPI
+
+    from dolfinx_forms import protocol
+    from dolfinx_forms.solver import ContactProblem, Dirichlet
+    from meshes.cut import hertz_cut_scene
+
+    sc = hertz_cut_scene(MPI.COMM_SELF, R=10.0, width=20.0, depth=10.0, h=0.25, zone=1.6)
+    top = Dirichlet("cylinder_top", 1, 0.0)
+    pb = ContactProblem(
+        sc,
+        {b.tag: (1e4, 0.3) for b in sc.bodies},
+        band=1.6**2 / 20.0,
+        dirichlet=[Dirichlet("block_bottom", None, 0.0), Dirichlet("cylinder_top", 0, 0.0), top],
+        enforcement="augmented",
+        linear_solver="condensed",
+        log=lambda *a, **k: None,
+    )
+    pb.newton.al_first, pb.newton.al_eta = al_first, al_eta
+    calls = []
+    solve, setup = pb.linear.solve, pb.linear.setup
+
+    def counted(b, x):
+        calls.append(1)
+        solve(b, x)
+
+    def forget(J, key):  # operator 0: "unknown", so the border is solved again
+        setup(J, key)
+        pb.linear.operator = 0
+
+    pb.linear.solve = counted
+    if fresh_border:
+        pb.linear.setup = forget
+    protocol.reach_force(pb, top, "block_bottom", 1, 430.0, first_guess=-0.05)
+    return pb, len(calls)
+
+
+def test_inexact_uzawa_and_border_reuse():
+    """The loop's solves stop early (al_first, al_eta) and the last one goes to rtol: the same state as
+    every solve to rtol, to the loop's tolerance (al_rtol = 1e-7 of the largest traction), in
+    fewer Newton iterations. The force control's border w = J^-1 g is solved once per operator:
+    reusing it changes nothing (round-off) and saves a solve per iteration with an unchanged
+    J (the later Uzawa solves of a settled active set)."""
+    exact, _ = _cut_hertz_force(0.0, 0.0)
+    early, n_reuse = _cut_hertz_force(1e-2, 1e-3)  # the defaults
+    fresh, n_fresh = _cut_hertz_force(1e-2, 1e-3, fresh_border=True)
+    its = [sum(s.iterations for s in p.steps) for p in (exact, early)]
+    assert its[1] < its[0]
+    u0, u1, u2 = (p.u.x.array for p in (exact, early, fresh))
+    assert np.abs(u1 - u0).max() <= 1e-6 * np.abs(u0).max()
+    assert np.abs(u1 - u2).max() <= 1e-10 * np.abs(u0).max()
+    for p in (exact, early):  # the step ends on a solve to Newton's tolerance
+        r = p.steps[-1].residuals
+        assert r[-1] <= max(p.newton.rtol * r[0], p.newton.ftol * p.force_scale)
+    assert n_fresh == 2 * its[1]  # one solve for du, one for the border per iteration
+    assert n_reuse < n_fresh
