@@ -30,10 +30,15 @@ from .laws import as_law
 from .newton import ContactSolverError, NewtonOptions, StepLog, load_steps  # noqa: F401
 
 # the augmented Lagrangian's point-wise regularisation with traction "points" (`contact_set`),
-# eps_n = eps_t = POINTWISE_EPS0 h / E: Hertz at h = a/20 (P1 nodes h / 1.5 h apart) gives
+# eps_n = POINTWISE_EPS0 h / E: Hertz at h = a/20 (P1 nodes h / 1.5 h apart) gives
 # p(x) 1.35 / 0.94 / 0.91 / 1.26 % body-fitted and 1.85 / 1.21 / 1.19 / 1.62 % cut at
 # 0.5 / 1 / 2 / 5; stiffer approaches the over-constrained point-wise contact (3.5 % at 0.1)
 POINTWISE_EPS0 = 2.0
+# eps_t = POINTWISE_EPS0_T h / E: Cattaneo-Mindlin (Q = 0.5 mu P, mu 0.1 and 1, a/20 and a/10,
+# both paths) gives the stick half-width off by -0.3 ... +1.5 % at 1.25, -0.05 ... +1.7 % at
+# 1.5 (a/20: +0.1 % body-fitted, +0.35 % cut) and +0.6 ... +2.0 % at 2 (the penalty: +0.06 ...
+# +0.9 %); q(x) moves by at most 0.4 points of % over the three (docs/demos.md)
+POINTWISE_EPS0_T = 1.5
 # below this many dofs one BLAS thread (`blas.threads_for`; measured on cut Hertz: one thread
 # as fast at 8.5k dofs and steadier, two 7 % faster at 1e5)
 BLAS_ONE_THREAD_DOFS = 50_000
@@ -65,8 +70,9 @@ class ContactProblem:
     1.5 h cut (Hertz at h = a/20, P1: 0.5 h and, on the cut path, 0.75 h give a checkerboard;
     p(x) 1.9 / 2.3 / 3.1 % body-fitted at 0.75 / 1 / 1.5 h, 3.9 / 3.4 % cut at 1 / 1.5 h, with
     traction "nodes"). traction: "nodes" (the law on each node's weighted mean gap) or "points"
-    (the law at each point with the multipliers interpolated, `contact_set`; the kernel's eps
-    is then POINTWISE_EPS0 h / E_mean and eps0 relaxes the Uzawa step by min(1, that / eps));
+    (the law at each point with the multipliers interpolated, `contact_set`; the kernel's eps_n
+    and eps_t are then POINTWISE_EPS0 and POINTWISE_EPS0_T times h / E_mean, and eps0 relaxes
+    the Uzawa step by min(1, eps_n / eps));
     default "points" with "augmented".
     linear_solver: "auto", "condensed", "factorised" or "iterative" (`linear.py`: a linear bulk
     on one process is factorised once, with Newton on the Schur complement of the contact dofs;
@@ -170,7 +176,7 @@ class ContactProblem:
             # the point-wise regularisation is part of the discretisation; eps0 sets the step
             fine = POINTWISE_EPS0 * h / E_mean
             relaxation = min(1.0, fine / self.eps_n)
-            self.eps_n = self.eps_t = fine
+            self.eps_n, self.eps_t = fine, POINTWISE_EPS0_T * h / E_mean
         with self.phase("contact"):
             self.contact = ContactSet(
                 self.V,
