@@ -7,8 +7,10 @@ at contact mesh sizes h = a/10, a/14, a/20, a/28, a/40, a/56, a/80 (a: the Hertz
 the demo defaults, ~1 mm; a/56 and a/80 so that both paths reach 0.5 %) for each
 discretization variant. Variants: the body-fitted (gmsh) path p1-tri, p2-tri, p1-quad, p2-quad
 (hertz.py [--degree 2] [--quads]) and the cut path q1-cut (hertz.py --discretization cut:
-level sets on a graded structured grid, Q1, hertz.py's default ghost penalty); default
-p1-tri,p1-quad,q1-cut, so one run compares both paths.
+level sets on a graded structured grid, Q1, hertz.py's default ghost penalty), each with the
+default penalty; p1-tri-al and q1-cut-al the same with --enforcement augmented (P1
+multipliers, point-wise traction). Default p1-tri,p1-quad,q1-cut,p1-tri-al,q1-cut-al, so one
+run compares both paths and both enforcements.
 
 GetFEM. When `import getfem` works (Debian's python3-getfem; `make bench` installs it) the same
 run also runs benchmarks/getfem_hertz.py (GetFEM's nodal P1 contact between the two bodies,
@@ -53,7 +55,7 @@ time is recorded beside it as wall_s. Running a demo and turning its metrics.jso
 is demos/convergence_study.py's run_hertz (shared, with the variants' arguments and the log-log
 fit).
 
-Usage: /usr/bin/python3 benchmarks/work_precision.py [--quick] [--variants p1-tri,p1-quad,q1-cut]
+Usage: /usr/bin/python3 benchmarks/work_precision.py [--quick] [--variants p1-tri,q1-cut,...]
                                                      [--out-dir benchmarks/results] [--timeout S]
                                                      [--no-getfem] [--getfem-divisors 5,...,56]
   --quick: a/10, a/14, a/20 only (default variants p1-tri,q1-cut; GetFEM a/7, a/10, a/14,
@@ -105,7 +107,8 @@ GETFEM_DIVISORS = (5, 7, 10, 12, 14, 17, 20, 24, 28, 34, 40, 56)
 QUICK_GETFEM_DIVISORS = (7, 10, 14, 20)
 TARGET_LOW = 0.005  # the second error of the GetFEM comparison (the first: GetFEM's best)
 BEST_TIE = 0.02  # GetFEM runs within 2 % of its smallest error are ties: the fastest is "best"
-DEFAULT_VARIANTS = "p1-tri,p1-quad,q1-cut"  # p2-tri is selectable (about 8 minutes alone)
+# p2-tri is selectable (about 8 minutes alone); -al: augmented Lagrangian enforcement
+DEFAULT_VARIANTS = "p1-tri,p1-quad,q1-cut,p1-tri-al,q1-cut-al"
 QUICK_VARIANTS = "p1-tri,q1-cut"
 TARGET = 0.02  # pressure L2 error of the time-to-precision figure
 
@@ -509,6 +512,8 @@ COLORS = {
     "p1-quad": "tab:green",
     "p2-quad": "tab:red",
     "q1-cut": "tab:purple",
+    "p1-tri-al": "tab:cyan",
+    "q1-cut-al": "tab:pink",
     GETFEM_VARIANT: "k",
 }
 PHASE_COLORS = {

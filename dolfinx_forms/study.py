@@ -300,6 +300,9 @@ VARIANTS = {  # name -> hertz.py arguments selecting the discretisation
     "p1-quad": ["--quads"],
     "p2-quad": ["--degree", "2", "--quads"],
     "q1-cut": ["--discretization", "cut"],
+    # the augmented Lagrangian (P1 multipliers, point-wise traction) on the default meshes
+    "p1-tri-al": ["--enforcement", "augmented"],
+    "q1-cut-al": ["--discretization", "cut", "--enforcement", "augmented"],
 }
 ERROR_LABELS = {
     "half_width_rel_error": "a",
