@@ -418,8 +418,9 @@ def check_scale(parser, args, size, what, max_cells=2000, displacement=True):
 AUGMENTED_EPS0 = 1e-2
 
 
-# the multi-step MPM runs the penalty only (`mpm.ImplicitMPM` refuses the other): its demos'
-# --enforcement choices
+# the multi-step MPM runs the penalty only (`mpm.ImplicitMPM` refuses the other: its grains'
+# contacts span about one cell, and P1 multipliers h apart widen and soften such a contact,
+# `checks.MIN_NODES`): its demos' --enforcement choices
 MPM_ENFORCEMENT = ("penalty",)
 
 

@@ -124,7 +124,8 @@ class ImplicitMPM:
         if problem_kw.get("enforcement", "penalty") != "penalty":
             raise ValueError(
                 "enforcement: the multi-step MPM supports 'penalty' only (its friction transfer "
-                "carries point-wise slip from step to step)"
+                "carries point-wise slip from step to step, and its contacts span about one "
+                "grid cell, too few for the augmented Lagrangian's P1 multipliers)"
             )
         self.problem_kw = problem_kw
         self.points = None  # {tag: MaterialPoints}, seeded on the first scene

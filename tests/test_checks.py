@@ -23,6 +23,7 @@ def pair(state, g_n=None, g_n0=None):
         points=np.c_[x, np.zeros(n)][::-1].copy(),  # any order: sorted along the tangent
         tangents=np.tile([1.0, 0.0], (n, 1)),
         g_n0=np.zeros(n) if g_n0 is None else g_n0[::-1].copy(),
+        num_nodes=0,  # no multiplier nodes (the penalty's pairs)
     )
     s = dict(
         state=np.asarray(state, np.int8)[::-1].copy(),
@@ -81,3 +82,13 @@ def test_demo_reports_soft_penalty(tmp_path):
     assert any("penetration" in w for w in warnings)
     assert any("band" in w for w in warnings)
     assert sum(line.startswith("WARNING: ") for line in r.stdout.splitlines()) == len(warnings)
+
+
+def test_demo_reports_under_resolved_multipliers(tmp_path):
+    """Augmented at h = a/2: 6 multiplier nodes carry the Hertz pressure (body-fitted), the P1
+    multipliers widen the zone (a +9.2 % against the penalty's +2.7 %): flagged. At a/10 (20
+    nodes) quiet (test_demo_reports_stiff_penalty)."""
+    m, r = hertz(tmp_path / "coarse", "--h", "0.5", "--enforcement", "augmented")
+    (w,) = [w for w in m["solver"]["warnings"] if "multiplier nodes carry" in w]
+    assert "only 6 multiplier nodes" in w
+    assert f"WARNING: {w}" in r.stdout
