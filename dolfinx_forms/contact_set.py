@@ -263,12 +263,16 @@ class ContactSet:
         parts = [law(g, s[key]) for key in keys for g, s in zip(self.pairs, self.last)]
         return np.concatenate(parts) if parts else np.zeros(0)
 
-    def assemble(self, u, b, A=None, fd=False, fd_step=1e-9, closed_gap=0.0):
+    def assemble(self, u, b, A=None, fd=False, fd_step=1e-9, closed_gap=0.0, stick=False):
         """Add the contact residual of displacement array u to the array b (local, with
         ghosts) and, with A, the consistent tangent; keep the trial states. closed_gap: open
-        points with g_n < closed_gap lend a closed point's tangent (the predictor, kernel)."""
+        points with g_n < closed_gap lend a closed point's tangent (the predictor, kernel).
+        stick (with friction): every closed point sticks (residual and tangent of an infinite
+        mu): the elastic predictor of the first iteration of a step, whose trial slip is the
+        whole step's motion."""
+        mu = 1e30 if stick and self.mu > 0 else None
         for k in range(len(self.pairs)):
-            s = self._evaluate(k, u, b, A, fd, fd_step, closed_gap=closed_gap)
+            s = self._evaluate(k, u, b, A, fd, fd_step, mu=mu, closed_gap=closed_gap)
             self.last[k] = s
             if self.mu > 0:
                 self.history[k].trial = s["gtp_trial"]

@@ -29,6 +29,13 @@ class NewtonOptions:
     fd_tangent: bool = False  # verification only: central differences of the contact residual
     fd_step: float = 1e-9
     line_search: bool = True  # halve a Newton step that does not lower the residual
+    # friction: the first iteration of a step is the elastic predictor (every closed point
+    # sticks: residual and tangent of an infinite mu), the return mapping from the next on. A
+    # platen moved sideways by a step of a stuck block (tests/test_mpm.py): 1 Newton
+    # iteration, where the slip the step's motion predicts cycled stick/slip through 4
+    # cut-backs (16 sub-steps); Hertz-Mindlin, the blocks, the incline and the MPM demos take
+    # the iterations they took
+    stick_predictor: bool = True
     max_backtracks: int = 5
     # augmented Lagrangian (Uzawa): stop when no multiplier changes by more than al_rtol of
     # the largest traction *and* no gap by more than al_gtol h (the change of a multiplier is
@@ -72,7 +79,8 @@ def newton(problem, lam, r_ref=0.0, early=0.0):
     r_base, sig_base, backtracks = None, None, 0  # where the last Newton step started
     for it in range(opts.max_iterations + 1):
         predictor = it == 0 and not later and problem.predictor_gap > 0
-        r = problem.residual(lam, with_tangent=True, predictor=predictor)
+        stick = it == 0 and not later and opts.stick_predictor and problem.contact.mu > 0
+        r = problem.residual(lam, with_tangent=True, predictor=predictor, stick=stick)
         residuals.append(r)
         if not np.isfinite(r):
             return (
@@ -125,7 +133,7 @@ def newton(problem, lam, r_ref=0.0, early=0.0):
         # J is the same matrix (its factorisation reused) for a linear bulk, the same active
         # set, mu and a constant contact tangent (frictionless or no slipping point), no predictor
         key = None
-        if not problem.bulk.nonlinear and not predictor:
+        if not problem.bulk.nonlinear and not predictor and not stick:
             slip = problem.contact.mu > 0 and problem.comm.allreduce(
                 int(problem.contact.state_counts()[2]), MPI.SUM
             )

@@ -262,7 +262,7 @@ class ContactProblem:
         for d, dofs in zip(self.dirichlet, self.bc_dofs):
             x[dofs] = d.at(lam)
 
-    def residual(self, lam, with_tangent=False, zero_bc=True, predictor=False):
+    def residual(self, lam, with_tangent=False, zero_bc=True, predictor=False, stick=False):
         """R = F_bulk(u) - f(lam) + r_c(u) (owned part); with_tangent also fills self.J (with
         `predictor`, the first iteration's tangent: see predictor_gap)."""
         with self.phase("assembly"):
@@ -284,6 +284,7 @@ class ContactProblem:
                 self.newton.fd_tangent,
                 self.newton.fd_step,
                 self.predictor_gap if predictor else 0.0,
+                stick,
             )
             self._rc.x.scatter_reverse(la.ScatterMode.add)
         with self.phase("assembly"):
