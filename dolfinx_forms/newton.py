@@ -33,8 +33,9 @@ class NewtonOptions:
     # sticks: residual and tangent of an infinite mu), the return mapping from the next on. A
     # platen moved sideways by a step of a stuck block (tests/test_mpm.py): 1 Newton
     # iteration, where the slip the step's motion predicts cycled stick/slip through 4
-    # cut-backs (16 sub-steps); Hertz-Mindlin, the blocks, the incline and the MPM demos take
-    # the iterations they took
+    # cut-backs (16 sub-steps); Hertz-Mindlin, the blocks, the incline, nine discs and four
+    # grains take the iterations they took, the Brazilian disc 4.98 per step instead of 4.84,
+    # the grain assembly 7.8 instead of 7.9, all with the same answers
     stick_predictor: bool = True
     max_backtracks: int = 5
     # augmented Lagrangian (Uzawa): stop when no multiplier changes by more than al_rtol of
