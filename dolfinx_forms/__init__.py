@@ -9,6 +9,10 @@ return mapping). Equation numbers refer to Liu & Sun, ILS-MPM (seed paper 000).
 import os
 import sys
 
+from . import plot_worker as _plot_worker
+
+_plot_worker.start_early()  # a demo's plot: matplotlib's import overlaps ours (plot_worker.py)
+
 # A process started without mpirun is an Open MPI singleton: by default its MPI_Init starts a
 # helper daemon (for MPI_Comm_spawn, which this code never calls), ~0.4 s of every run's start.
 # Under mpirun the setting has no effect; a user's own value is kept.

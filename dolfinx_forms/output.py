@@ -83,9 +83,9 @@ def plot_tractions(path, pts, analytic=None, title="", xlabel="x (mm)", ylabel="
 def plot_lines(path, lines, title="", xlabel="x (mm)", ylabel="", vlines=()):
     """Curves {label: (x, y, style)} (style "-": a line, ".": points) and dotted vertical lines
     at the abscissae `vlines`, in one PNG (plot_worker.draw; in the worker of
-    `start_plot_worker` if one was started and is unused)."""
+    `start_plot_worker`, or the demo's early one, if one was started and is unused)."""
     global _worker
-    worker, _worker = _worker, None
+    worker, _worker = _worker or plot_worker.take_early(), None
     if worker is None or not worker.plot(path, lines, title, xlabel, ylabel, vlines):
         plot_worker.draw(path, lines, title, xlabel, ylabel, vlines)
 
@@ -98,7 +98,7 @@ def start_plot_worker():
     unused one is ended."""
     global _worker
     stop_plot_worker()
-    _worker = plot_worker.start()
+    _worker = plot_worker.take_early() or plot_worker.start()
 
 
 def stop_plot_worker():

@@ -124,6 +124,48 @@ def test_plot_worker_only_when_a_core_is_idle(monkeypatch):
     worker.close()
 
 
+def test_plot_worker_started_early_for_a_demo(monkeypatch, tmp_path):
+    """A script in demos/ (rank 0) starts the worker as the package is imported; the first
+    plot takes it over; another script, another rank or ILS_EARLY_PLOT=0 does not start it."""
+    import types
+
+    from dolfinx_forms import output, plot_worker
+
+    started = []
+    monkeypatch.setattr(plot_worker, "start", lambda: started.append(1) or "worker")
+    main = types.SimpleNamespace(__file__=str(ROOT / "demos" / "hertz.py"))
+    monkeypatch.setitem(sys.modules, "__main__", main)
+    for env in ({"OMPI_COMM_WORLD_RANK": "1"}, {"ILS_EARLY_PLOT": "0"}):
+        with monkeypatch.context() as m:
+            for k, v in env.items():
+                m.setenv(k, v)
+            plot_worker.start_early()
+        assert plot_worker.take_early() is None and not started
+    main.__file__ = str(tmp_path / "hertz.py")  # not this repository's demos
+    plot_worker.start_early()
+    assert plot_worker.take_early() is None and not started
+    main.__file__ = str(ROOT / "demos" / "hertz.py")
+    plot_worker.start_early()
+    assert started == [1]
+    output.start_plot_worker()  # run_case: takes the early worker, starts no other
+    assert output._worker == "worker" and started == [1] and plot_worker.take_early() is None
+    output._worker = None
+
+
+def test_demo_process_plots_with_the_early_worker(tmp_path):
+    """The demo's PNG is written whether the early worker draws it or the process does."""
+    for early in ("1", "0"):
+        out = tmp_path / early
+        r = subprocess.run(
+            [sys.executable, str(ROOT / "demos" / "patch_test.py"), "--out", str(out)],
+            env=dict(os.environ, PYTHONPATH=str(ROOT), ILS_EARLY_PLOT=early),
+            capture_output=True,
+            text=True,
+        )
+        assert r.returncode == 0, r.stderr
+        assert (out / "tractions.png").stat().st_size > 1000
+
+
 def test_exit_process_status():
     """cli.exit_process: the status reaches the shell (0, 1)."""
     for status in (0, 1):
