@@ -138,7 +138,8 @@ def main(argv=None):
     print("degree  node spacing/h  best L2 error (min .. max over offsets)")
     for r in rows:
         print(
-            f"P{r['degree']}      {r['node_spacing_h']:5.2f}           {100 * r['min']:.2f} .. {100 * r['max']:.2f} %"
+            f"P{r['degree']}      {r['node_spacing_h']:5.2f}           "
+            f"{100 * r['min']:.2f} .. {100 * r['max']:.2f} %"
         )
     if __package__:
         from .work_precision import write_atomic, write_json

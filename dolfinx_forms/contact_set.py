@@ -30,12 +30,12 @@ keeps the point-wise shape of the gap between the nodes: the contact edge and th
 boundary fall between nodes as with the penalty (Hertz at h = a/20: p(x) 0.91 % body-fitted,
 1.19 % cut, against 2.43 % and 3.46 % with traction "nodes"). eps_n and eps_t are then part
 of the discretisation (`solver.POINTWISE_EPS0`, `POINTWISE_EPS0_T`), and the user's eps0 only
-relaxes the Uzawa step (`relaxation` <= 1). A zero mean gap at every active node instead (Uzawa on the nodes'
-weighted mean gaps, lambda <- min(0, lambda + M_L^-1 int psi (tau - lambda_h)) node by node)
-converges to 1e-9 h, but its pressure depends on where the nodes fall against the contact
-edge: Hertz at h = 0.05, loads 350-520 (nodes 1.25 h apart, eps 1.5 h/E: its best at a/20),
-0.92-1.55 % body-fitted and 1.15-2.05 % cut, against
-0.92-1.02 % and 0.99-1.17 % for this projection (docs/demos.md).
+relaxes the Uzawa step (`relaxation` <= 1). A zero mean gap at every active node instead
+(Uzawa on the nodes' weighted mean gaps, lambda <- min(0, lambda + M_L^-1 int psi (tau -
+lambda_h)) node by node) converges to 1e-9 h, but its pressure depends on where the nodes fall
+against the contact edge: Hertz at h = 0.05, loads 350-520 (nodes 1.25 h apart, eps 1.5 h/E:
+its best at a/20), 0.92-1.55 % body-fitted and 1.15-2.05 % cut, against 0.92-1.02 % and
+0.99-1.17 % for this projection (docs/demos.md).
 """
 
 import numpy as np

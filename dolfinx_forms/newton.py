@@ -64,6 +64,13 @@ class StepLog:
     augmentations: int = 0  # augmented Lagrangian: the Newton solves after the first (Uzawa)
 
 
+def tolerance(problem, r0):
+    """The residual a Newton solve must reach: rtol of its first residual r0, with a round-off
+    floor relative to the problem's force scale (and the user's absolute atol)."""
+    opts = problem.newton
+    return max(opts.rtol * r0, opts.ftol * problem.force_scale, opts.atol)
+
+
 def newton(problem, lam, r_ref=0.0, early=0.0):
     """Newton at load level lam from the committed state of `problem` (a ContactProblem).
     r_ref: a residual that the relative test may also refer to (the step's first residual, for
@@ -98,9 +105,7 @@ def newton(problem, lam, r_ref=0.0, early=0.0):
         # relative to the step's first residual, with a round-off floor relative to the
         # problem's force scale: no absolute floor that would accept the initial guess of a
         # problem with small forces (E = 1e-12 converges like E = 1)
-        if (it > 0 or not later) and r <= max(
-            opts.rtol * r0, opts.ftol * problem.force_scale, opts.atol, early * r0
-        ):
+        if (it > 0 or not later) and r <= max(tolerance(problem, r0), early * r0):
             return True, residuals, ""
         if it > 0:
             dnorm, unorm = problem.du.vector.norm(), problem.u.vector.norm()
@@ -187,8 +192,7 @@ def augmented_loop(problem, lam, residuals, depth=20):
         change = comm.allreduce(float(np.abs(f).max()) if f.size else 0.0, MPI.MAX)
         scale = comm.allreduce(float(np.abs(t).max()) if f.size else 0.0, MPI.MAX)
         if change <= min(opts.al_rtol * scale, gap_tol):
-            tight = max(opts.rtol * residuals[0], opts.ftol * problem.force_scale, opts.atol)
-            if residuals[-1] <= tight:
+            if residuals[-1] <= tolerance(problem, residuals[0]):
                 return True, solves, ""
             ok, more, why = newton(problem, lam, residuals[0])  # the last solve stopped early
             residuals += more

@@ -199,8 +199,8 @@ def _cut_hertz_force(al_first, al_eta, fresh_border=False):
 
 
 def test_inexact_uzawa_and_border_reuse():
-    """The loop's solves stop early (al_first, al_eta) and the last one goes to rtol: the same state as
-    every solve to rtol, to the loop's tolerance (al_rtol = 1e-7 of the largest traction), in
+    """The loop's solves stop early (al_first, al_eta) and the last one goes to rtol: the same
+    state as every solve to rtol, to the loop's tolerance (al_rtol = 1e-7 of the largest traction), in
     fewer Newton iterations. The force control's border w = J^-1 g is solved once per operator:
     reusing it changes nothing (round-off) and saves a solve per iteration with an unchanged
     J (the later Uzawa solves of a settled active set)."""
