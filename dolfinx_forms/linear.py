@@ -15,6 +15,12 @@ dofs of the cells that hold closest points: a few hundred of 1e4-1e6).
   expands through the one sparse factorisation (`_cpp.schur_factor`, `_cpp.schur_update`).
   Should one dense update take longer than twice that factorisation (m too large for n), it
   hands over to `Factorised` for the rest of the run.
+  A symmetric bulk (the linear laws) whose Dirichlet dofs are not contact dofs is factorised
+  as LDL^T (MUMPS Cholesky, ~0.7x LU's time and half its memory) with the Dirichlet rows *and
+  columns* eliminated; a solve then lifts the Dirichlet values (b_F - K_FD b_D). Its Schur
+  complement is factorised symmetric too, so a problem with friction starts with LU, and the
+  first non-symmetric J of a frictionless one (friction switched on later: slip's tangent)
+  refactorises the bulk once as LU for the rest of the run.
 
 * `Iterative` (issue 12, "large problems"): CG preconditioned by PETSc's smoothed-aggregation
   AMG (GAMG) with the rigid-body modes as its near-null space, the AMG set-up reused across
@@ -34,6 +40,8 @@ from petsc4py import PETSc
 from . import _cpp
 
 DEFAULT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+# a symmetric bulk or Schur complement: |A - A^T| <= this * |A| (round-off of the assembly)
+SYMMETRY_RTOL = 1e-12
 MAX_CONDENSED = 6000  # the dense m x m blocks (3 of them) stay below ~1 GB
 # Iterative's defaults: the Krylov method is chosen by the tangent's symmetry (Iterative)
 # threshold 0.05: 61 -> 40 CG iterations on body-fitted Hertz (45k dofs); Chebyshev smoothers
@@ -107,23 +115,39 @@ class Condensed:
 
     def __init__(self, problem, dofs, petsc_options=None):
         self.problem, self.petsc_options = problem, petsc_options
-        t0 = time.perf_counter()
-        K0 = problem.K.copy()
-        K0.zeroRows(problem.bc_global, diag=1.0)
         self.IS = PETSc.IS().createGeneral(np.asarray(dofs, dtype=np.int32), comm=problem.comm)
-        self.F, S0 = _cpp.schur_factor(K0, self.IS)
+        self.bc = np.asarray(problem.bc_global, dtype=np.int32)
+        # LDL^T needs K symmetric and J - K0 inside the (c, c) block of free dofs; with
+        # friction from the start (the MPM steps) J will not stay symmetric
+        symmetric = problem.mu == 0 and not np.isin(self.bc, dofs).any() and _symmetric(problem.K)
+        self.num_dofs = len(dofs)
+        self.factorisations = 0  # sparse
+        self.schur_factorisations = 0  # dense, m x m
+        self.key, self.full = None, None
+        self.operator = 0  # the J set up last (`_OPERATORS`; 0: none)
+        self._factor(symmetric)
+
+    def _factor(self, symmetric):
+        """The sparse factorisation of the bulk K0 (rows of the Dirichlet dofs zeroed, 1 on
+        the diagonal; symmetric: their columns too) and the dense base S0 - K0_cc."""
+        t0 = time.perf_counter()
+        self.F = self.base = self.S = None  # the previous factor's memory first
+        self.symmetric = symmetric
+        A = self.problem.K.copy()
+        if symmetric:
+            A.zeroRowsColumns(self.bc, diag=1.0)
+        else:
+            A.zeroRows(self.bc, diag=1.0)
+        self.F, S0 = _cpp.schur_factor(A, self.IS, symmetric)
         # S = S0 + (J_cc - K0_cc) is formed in one buffer from J_cc's sparse rows: its
         # conversion to a dense Mat and fresh m x m arrays cost 7 ms and 4-6 ms of page faults
         # per update at m = 456 (cut Hertz a/20) on these machines, against 0.3 ms
         # (only base and S are kept: two m x m arrays, 230 MB each at m = 5340)
-        self.base = S0 - _dense(K0.createSubMatrix(self.IS, self.IS))
+        self.base = S0 - _dense(A.createSubMatrix(self.IS, self.IS))
         self.S = np.empty_like(S0)
         self.t_factor = time.perf_counter() - t0
-        self.num_dofs = len(dofs)
-        self.factorisations = 1  # sparse, once
-        self.schur_factorisations = 0  # dense, m x m
-        self.key, self.full = None, None
-        self.operator = 0  # the J set up last (`_OPERATORS`; 0: none)
+        self.factorisations += 1
+        self.key = None
 
     def setup(self, J, key):
         if self.full is not None:
@@ -135,9 +159,16 @@ class Condensed:
         self.key = key
         self.operator = next(_OPERATORS)
         t0 = time.perf_counter()
-        ai, aj, av = J.createSubMatrix(self.IS, self.IS).getValuesCSR()
+        Jcc = J.createSubMatrix(self.IS, self.IS)
+        ai, aj, av = Jcc.getValuesCSR()
+        rows = np.repeat(np.arange(len(ai) - 1), np.diff(ai))
         self.S[...] = self.base
-        self.S[np.repeat(np.arange(len(ai) - 1), np.diff(ai)), aj] += av  # one entry per (i, j)
+        self.S[rows, aj] += av  # one entry per (i, j)
+        if self.symmetric and not _symmetric(Jcc):  # the base is symmetric
+            self._factor(False)  # friction on: LU from here on, with LU's S0
+            self.key, t0 = key, time.perf_counter()
+            self.S[...] = self.base
+            self.S[rows, aj] += av
         _cpp.schur_update(self.F, self.S)
         self.schur_factorisations += 1
         # m too large for its n (timer noise aside: twice, and 50 ms): refactorise instead
@@ -153,7 +184,20 @@ class Condensed:
     def solve(self, b, x):
         if self.full is not None:
             return self.full.solve(b, x)
-        self.F.solve(b, x)
+        bD = b.getArray(readonly=True)[self.bc]
+        if not self.symmetric or not bD.any():
+            return self.F.solve(b, x)
+        # the columns eliminated from the factor: b_F - K_FD b_D (rows D keep b_D)
+        ext = b.duplicate()
+        ext.zeroEntries()
+        ext.setValues(self.bc, bD)
+        ext.assemble()
+        rhs = b.duplicate()
+        self.problem.K.mult(ext, rhs)
+        rhs.aypx(-1.0, b)
+        rhs.setValues(self.bc, bD)
+        rhs.assemble()
+        self.F.solve(rhs, x)
 
     @property
     def factorisations(self):
@@ -333,6 +377,11 @@ def rigid_modes(problem):
 
 def _dense(A):
     return A.convert("dense").getDenseArray().copy()
+
+
+def _symmetric(A):
+    """A (sparse) symmetric to SYMMETRY_RTOL of its norm (MatIsSymmetric's tol is absolute)."""
+    return A.isSymmetric(SYMMETRY_RTOL * A.norm(PETSc.NormType.INFINITY))
 
 
 def contact_dofs(problem):

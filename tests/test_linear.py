@@ -64,10 +64,52 @@ def test_condensed_equals_factorised(kind):
     ua, ub = a.u.x.array, b.u.x.array
     assert np.abs(ua - ub).max() <= 1e-9 * np.abs(ub).max()
     assert [s.iterations for s in a.steps] == [s.iterations for s in b.steps]
-    # one sparse factorisation for the whole path, one dense Schur update per changed J
-    assert a.factorisations == 1 and b.factorisations > 1
+    # two sparse factorisations for the whole path (LDL^T while frictionless, LU from the
+    # first slip's non-symmetric J on), one dense Schur update per changed J
+    assert a.factorisations == 2 and b.factorisations > 2
+    assert not a.linear.symmetric
     assert 0 < a.linear.schur_factorisations <= b.factorisations  # none while nothing touches
     assert a.reaction("cylinder_top")[0] == pytest.approx(0.5 * 0.3 * P, rel=1e-9)
+
+
+@pytest.mark.parametrize("kind", ["conforming", "cut"])
+def test_symmetric_factor_while_frictionless(kind):
+    """Normal force only: the bulk stays factorised once, as LDL^T with the Dirichlet columns
+    eliminated and the moving top's values lifted in each solve (force control moves them:
+    the border solves have b_D != 0); the same iterates as LU per iteration."""
+    sc = scene(kind)
+    runs = []
+    for solver in ("condensed", "factorised"):
+        pb, top_x, top_y = hertz_problem(sc, solver)
+        protocol.reach_force(pb, top_y, "block_bottom", 1, P, first_guess=-0.05)
+        runs.append(pb)
+    a, b = runs
+    assert a.linear.symmetric and a.factorisations == 1
+    assert a.linear.schur_factorisations >= 2
+    ua, ub = a.u.x.array, b.u.x.array
+    assert np.abs(ua - ub).max() <= 1e-9 * np.abs(ub).max()
+    assert [s.iterations for s in a.steps] == [s.iterations for s in b.steps]
+    assert a.reaction("block_bottom")[1] == pytest.approx(P, rel=1e-9)
+
+
+def test_symmetric_solve_lifts_dirichlet_values():
+    """One solve with the LDL^T factor against LU on J = K0 with b_D != 0 (rows of the
+    Dirichlet dofs zeroed, columns kept): the same x to round-off."""
+    pb, top_x, top_y = hertz_problem(scene("conforming"), "condensed")
+    lin = pb.linear
+    assert lin.symmetric
+    K0 = pb.K.copy()
+    K0.zeroRows(pb.bc_global, diag=1.0)
+    lin.setup(K0, None)  # S = S0: J = K0, no contact
+    ref = linear.Factorised(pb)
+    ref.setup(K0, None)
+    b = K0.createVecLeft()
+    b.setArray(np.random.default_rng(1).standard_normal(b.getLocalSize()))
+    x, y = b.duplicate(), b.duplicate()
+    lin.solve(b, x)
+    ref.solve(b, y)
+    assert np.abs(b.array[lin.bc]).min() > 0
+    assert np.abs(x.array - y.array).max() <= 1e-10 * np.abs(y.array).max()
 
 
 def test_choice():

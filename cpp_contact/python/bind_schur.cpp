@@ -38,29 +38,42 @@ template <typename F> void for_dense(Mat S, PetscInt m, F&& f) {
 void bind_schur(py::module_& m) {
   m.def(
       "schur_factor",
-      [](Mat A, IS is) {
+      [](Mat A, IS is, bool symmetric) {
         Mat F = nullptr;
-        check(MatGetFactor(A, MATSOLVERMUMPS, MAT_FACTOR_LU, &F), "MatGetFactor (MUMPS)");
+        const MatFactorType type = symmetric ? MAT_FACTOR_CHOLESKY : MAT_FACTOR_LU;
+        check(MatGetFactor(A, MATSOLVERMUMPS, type, &F), "MatGetFactor (MUMPS)");
         check(MatFactorSetSchurIS(F, is), "MatFactorSetSchurIS");
         MatFactorInfo info;
         check(MatFactorInfoInitialize(&info), "MatFactorInfoInitialize");
-        check(MatLUFactorSymbolic(F, A, nullptr, nullptr, &info), "MatLUFactorSymbolic");
-        check(MatLUFactorNumeric(F, A, &info), "MatLUFactorNumeric");
+        if (symmetric) {
+          check(MatCholeskyFactorSymbolic(F, A, nullptr, &info), "MatCholeskyFactorSymbolic");
+          check(MatCholeskyFactorNumeric(F, A, &info), "MatCholeskyFactorNumeric");
+        } else {
+          check(MatLUFactorSymbolic(F, A, nullptr, nullptr, &info), "MatLUFactorSymbolic");
+          check(MatLUFactorNumeric(F, A, &info), "MatLUFactorNumeric");
+        }
         Mat S = nullptr;
         MatFactorSchurStatus status;
         check(MatFactorGetSchurComplement(F, &S, &status), "MatFactorGetSchurComplement");
         PetscInt m = 0;
         check(MatGetSize(S, &m, nullptr), "MatGetSize");
         std::vector<double> s0(std::size_t(m * m));
-        for_dense(S, m, [&](PetscInt i, PetscInt j, PetscScalar& v) { s0[i * m + j] = v; });
+        // LDL^T: MUMPS returns the lower triangle (column-major) only; mirror it
+        for_dense(S, m, [&](PetscInt i, PetscInt j, PetscScalar& v) {
+          if (!symmetric)
+            s0[i * m + j] = v;
+          else if (i >= j)
+            s0[i * m + j] = s0[j * m + i] = v;
+        });
         check(MatFactorRestoreSchurComplement(F, &S, status), "MatFactorRestoreSchurComplement");
         py::object f = py::cast(F); // petsc4py takes its own reference
         check(MatDestroy(&F), "MatDestroy");
         return py::make_tuple(f, to_numpy(std::move(s0), {py::ssize_t(m), py::ssize_t(m)}));
       },
-      py::arg("A"), py::arg("schur_is"),
-      "MUMPS LU of A with the dofs of schur_is eliminated last; returns (factor, S0) with S0 the "
-      "dense Schur complement (m, m) on those dofs (serial).");
+      py::arg("A"), py::arg("schur_is"), py::arg("symmetric") = false,
+      "MUMPS LU (symmetric: LDL^T of a symmetric A) of A with the dofs of schur_is eliminated "
+      "last; returns (factor, S0) with S0 the dense Schur complement (m, m) on those dofs "
+      "(serial).");
 
   m.def(
       "schur_update",
