@@ -34,9 +34,11 @@ from work_precision import write_atomic as replace_atomic  # the script's folder
 ROOT = Path(__file__).resolve().parents[1]
 
 
-# runs a script and prints its peak resident memory (kB) as the last line of stderr
+# runs a script (its folder first on sys.path, as `python3 script` has it) and prints its peak
+# resident memory (kB) as the last line of stderr
 WRAP = (
-    "import resource, runpy, sys; script = sys.argv[1]; sys.argv = sys.argv[1:]\n"
+    "import os, resource, runpy, sys; script = sys.argv[1]; sys.argv = sys.argv[1:]\n"
+    "sys.path.insert(0, os.path.dirname(os.path.abspath(script)))\n"
     "try:\n    runpy.run_path(script, run_name='__main__')\n"
     "except SystemExit as e:\n    code = e.code\nelse:\n    code = 0\n"
     "print('peak_rss_kb', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)\n"
