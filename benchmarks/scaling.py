@@ -29,16 +29,13 @@ import tempfile
 import time
 from pathlib import Path
 
-from work_precision import write_atomic as replace_atomic  # the script's folder is on sys.path
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-# runs a script (its folder first on sys.path, as `python3 script` has it) and prints its peak
-# resident memory (kB) as the last line of stderr
+# runs a script and prints its peak resident memory (kB) as the last line of stderr
 WRAP = (
-    "import os, resource, runpy, sys; script = sys.argv[1]; sys.argv = sys.argv[1:]\n"
-    "sys.path.insert(0, os.path.dirname(os.path.abspath(script)))\n"
+    "import resource, runpy, sys; script = sys.argv[1]; sys.argv = sys.argv[1:]\n"
     "try:\n    runpy.run_path(script, run_name='__main__')\n"
     "except SystemExit as e:\n    code = e.code\nelse:\n    code = 0\n"
     "print('peak_rss_kb', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)\n"
@@ -174,6 +171,15 @@ def _hertz_demo():
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def replace_atomic(path, write):
+    """work_precision.write_atomic, imported here: the script's folder is on sys.path when it
+    runs as the benchmark, not in its children (the demo and the reference run through WRAP,
+    runpy), which never write results."""
+    from work_precision import write_atomic as replace
+
+    replace(path, write)
 
 
 def write_atomic(path, text):
