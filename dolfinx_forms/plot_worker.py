@@ -135,8 +135,13 @@ def _serve():
     import matplotlib  # now, while the parent computes
 
     matplotlib.use("Agg")
+    import io
+
     import matplotlib.pyplot  # noqa: F401
 
+    # a throwaway figure while the parent computes: the first figure of a process pays for
+    # loading the fonts and the Agg renderer (0.11 s against 0.08 s for the next ones)
+    draw(io.BytesIO(), {"warm-up": ([0.0, 1.0], [0.0, 1.0], "-")}, "t", vlines=(0.5,))
     data = sys.stdin.buffer.read()
     if data:
         try:
