@@ -234,7 +234,8 @@ def pressure_errors(x, y, force, gauss=GAUSS):
     (sorted by x, one polyline) against Hertz at their total (module docstring): dict(load,
     contact_half_width, peak_pressure, analytic={contact_half_width, peak_pressure},
     errors={half_width_rel_error, peak_pressure_rel_error, pressure_rel_l2_error,
-    pressure_rel_l2_error_nodes})."""
+    pressure_rel_l2_error_nodes}, profile={x, p}: the slave nodes' x and pressures p_i, for
+    work_precision.py's error against a fine reference)."""
     seg = np.hypot(np.diff(x), np.diff(y))
     trib = np.zeros(x.size)  # int phi_i over the arc: row sums of the P1 boundary mass
     trib[:-1] += 0.5 * seg
@@ -267,6 +268,7 @@ def pressure_errors(x, y, force, gauss=GAUSS):
         load=P,
         contact_half_width=a,
         peak_pressure=p0,
+        profile=dict(x=x.tolist(), p=p.tolist()),  # the nodal pressures (their P1 interpolant)
         analytic=dict(contact_half_width=a_H, peak_pressure=p0_H),
         errors=dict(
             half_width_rel_error=abs(a - a_H) / a_H,

@@ -112,3 +112,28 @@ def test_work_precision_shares_the_runner():
     assert wp.parse(["--quick"]).variants == ["p1-tri", "q1-cut"]
     assert cs.loglog_rate([1, 2, 4], [1, 4, 16]) == pytest.approx(2.0)
     assert cs.loglog_rate([1, 1], [1, 2]) is None
+
+
+def test_work_precision_reference_measure(tmp_path):
+    """The error against the fine reference: exact on profiles whose interpolants it integrates
+    (0 for the same curve sampled at other points, 1 for a zero profile), the known value for
+    a scaled one, and a demo's tractions.csv read back sorted."""
+    import numpy as np
+
+    wp = load("work_precision", ROOT / "benchmarks" / "work_precision.py")
+    a = 1.0
+    xr = np.linspace(-1.2, 1.2, 2401)
+    ref = (xr, np.clip(1 - xr**2, 0, None))  # a parabola's hat: piecewise-linear to 1e-7
+    xs = np.linspace(-1.0, 1.0, 801)[::-1]  # other points, unsorted on purpose
+    same = np.sort(xs), 1 - np.sort(xs) ** 2
+    assert wp.profile_error(same, ref, a) == pytest.approx(0.0, abs=1e-5)
+    assert wp.profile_error((same[0], 1.1 * same[1]), ref, a) == pytest.approx(0.1, rel=1e-4)
+    assert wp.profile_error((xs[:2] * 0, np.zeros(2)), ref, a) == pytest.approx(1.0)
+    f = tmp_path / "tractions.csv"
+    f.write_text("x,y,p_n,p_t,gap_n,slip,state\n0.5,0,2,0,0,0,slip\n-0.5,0,1,0,0,0,slip\n")
+    x, p = wp.read_profile(f)
+    assert list(x) == [-0.5, 0.5] and list(p) == [1.0, 2.0]
+    assert wp.parse(["--reference-divisor", "0"]).reference_divisor == 0
+    assert wp.parse(["--quick"]).reference_divisor == wp.QUICK_REFERENCE_DIVISOR
+    with pytest.raises(SystemExit):
+        wp.parse(["--reference-divisor", "-3"])
