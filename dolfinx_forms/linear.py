@@ -71,36 +71,70 @@ class LinearSolverError(RuntimeError):
 
 
 class Factorised:
-    """KSP on the full J, the factorisation reused while J is unchanged."""
+    """KSP on the full J, the factorisation reused while J is unchanged.
+
+    symmetric (the default options, frictionless: `choose`): MUMPS Cholesky (LDL^T, ~0.7x LU's
+    time, half its memory) of J with its Dirichlet rows *and columns* eliminated, the values
+    lifted in each solve (x_D = b_D, b_F - J_FD b_D), as `Iterative` does; the first J that is
+    not symmetric (friction switched on, a non-symmetric law's tangent) turns it to LU."""
 
     name = "factorised"
 
-    def __init__(self, problem, petsc_options=None):
+    def __init__(self, problem, petsc_options=None, symmetric=False):
+        self.problem, self.symmetric = problem, bool(symmetric)
         self.ksp = PETSc.KSP().create(problem.comm)
         self.ksp.setOptionsPrefix("ils_")
         opts = PETSc.Options()
-        for k, v in {**DEFAULT_OPTIONS, **(petsc_options or {})}.items():
+        pc = {"pc_type": "cholesky"} if self.symmetric else {}
+        for k, v in {**DEFAULT_OPTIONS, **pc, **(petsc_options or {})}.items():
             opts["ils_" + k] = v
         self.ksp.setFromOptions()
         self.key = None  # what the last factorisation was of
         self.factorisations = 0
         self.operator = 0  # the J set up last (`_OPERATORS`; 0: none)
+        self.A = self.J = self.lift = self.t = None  # symmetric: J eliminated, J, work vectors
 
     def setup(self, J, key):
         """key: None (J changed), or a hashable description of J (the same key: same J)."""
         reuse = key is not None and key == self.key
+        if self.symmetric and not reuse:
+            if self.A is None:
+                self.A = J.duplicate(copy=False)
+                self.A.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
+                self.lift, self.t = J.createVecLeft(), J.createVecLeft()
+            J.copy(self.A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            self.A.zeroRowsColumns(self.problem.bc_global, diag=1.0)
+            if not _symmetric(self.A):
+                self.symmetric = False  # LU on J from here on (MUMPS: the default options)
+                self.ksp.getPC().setType("lu")
+                self.ksp.getPC().setFactorSolverType("mumps")
+                self.A = self.J = self.lift = self.t = None
         self.ksp.getPC().setReusePreconditioner(reuse)
         self.key = key
         self.factorisations += not reuse
         if not reuse:
             self.operator = next(_OPERATORS)
-        self.ksp.setOperators(J)
+        if self.symmetric:
+            self.J = J  # the lifting's columns
+        self.ksp.setOperators(self.A if self.symmetric else J)
 
     def solve(self, b, x):
-        self.ksp.solve(b, x)
+        rhs, lifted = b, False
+        if self.symmetric:
+            bc = self.problem.bc_owned
+            lifted = self.problem.comm.allreduce(bool(np.any(b.array[bc])), op=MPI.LOR)
+        if lifted:  # x_D = b_D; the free rows see -J_FD b_D
+            self.lift.zeroEntries()
+            self.lift.array[bc] = b.array[bc]
+            self.J.mult(self.lift, self.t)
+            self.t.aypx(-1.0, b)  # b - J lift: its Dirichlet rows are b_D - b_D = 0
+            rhs = self.t
+        self.ksp.solve(rhs, x)
         reason = self.ksp.getConvergedReason()
         if reason < 0:
             raise LinearSolverError(f"linear solver diverged (reason {reason})")
+        if lifted:
+            x.axpy(1.0, self.lift)
 
 
 class Condensed:
@@ -401,11 +435,12 @@ def choose(problem, kind="auto", petsc_options=None):
     dofs; Factorised otherwise."""
     if kind not in KINDS:
         raise ValueError(f"linear_solver: {', '.join(map(repr, KINDS))}, not {kind!r}")
+    default = not petsc_options or {**DEFAULT_OPTIONS, **petsc_options} == DEFAULT_OPTIONS
+    symmetric = default and problem.mu == 0  # Factorised's LDL^T, LU once J is not symmetric
     if kind == "factorised":
-        return Factorised(problem, petsc_options)
+        return Factorised(problem, petsc_options, symmetric)
     if kind == "iterative":
         return Iterative(problem, _without_direct(petsc_options))
-    default = not petsc_options or {**DEFAULT_OPTIONS, **petsc_options} == DEFAULT_OPTIONS
     if kind == "auto" and (petsc_options or {}).get("pc_type") == "gamg":
         return Iterative(problem, petsc_options)
     body_fitted = getattr(problem.scene, "cut", None) is None
@@ -425,7 +460,7 @@ def choose(problem, kind="auto", petsc_options=None):
         return Condensed(problem, dofs, petsc_options)
     if kind == "condensed":
         raise ValueError(f"linear_solver: 'condensed' does not apply here: {why}")
-    return Factorised(problem, petsc_options)
+    return Factorised(problem, petsc_options, symmetric)
 
 
 def _without_direct(petsc_options):

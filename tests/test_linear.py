@@ -67,7 +67,9 @@ def test_condensed_equals_factorised(kind):
     # two sparse factorisations for the whole path (LDL^T while frictionless, LU from the
     # first slip's non-symmetric J on), one dense Schur update per changed J
     assert a.factorisations == 2 and b.factorisations > 2
-    assert not a.linear.symmetric
+    assert not a.linear.symmetric and not b.linear.symmetric  # both LU since friction on
+    pc = b.linear.ksp.getPC()
+    assert (pc.getType(), pc.getFactorSolverType()) == ("lu", "mumps")
     assert 0 < a.linear.schur_factorisations <= b.factorisations  # none while nothing touches
     assert a.reaction("cylinder_top")[0] == pytest.approx(0.5 * 0.3 * P, rel=1e-9)
 
@@ -79,12 +81,21 @@ def test_symmetric_factor_while_frictionless(kind):
     the border solves have b_D != 0); the same iterates as LU per iteration."""
     sc = scene(kind)
     runs = []
-    for solver in ("condensed", "factorised"):
-        pb, top_x, top_y = hertz_problem(sc, solver)
+    for solver in ("condensed", "factorised", "lu"):
+        pb, top_x, top_y = hertz_problem(sc, "factorised" if solver == "lu" else solver)
+        if solver == "lu":
+            pb.linear = linear.Factorised(pb)  # LU of J, rows eliminated: the plain reference
         protocol.reach_force(pb, top_y, "block_bottom", 1, P, first_guess=-0.05)
         runs.append(pb)
-    a, b = runs
+    a, b, c = runs
+    assert c.linear.ksp.getPC().getType() == "lu"
+    for other in (a, b):
+        uo, uc = other.u.x.array, c.u.x.array
+        assert np.abs(uo - uc).max() <= 1e-9 * np.abs(uc).max()
+        assert [s.iterations for s in other.steps] == [s.iterations for s in c.steps]
     assert a.linear.symmetric and a.factorisations == 1
+    assert b.linear.symmetric  # Factorised's LDL^T of J with the Dirichlet columns eliminated
+    assert b.linear.ksp.getPC().getType() == "cholesky"
     assert a.linear.schur_factorisations >= 2
     ua, ub = a.u.x.array, b.u.x.array
     assert np.abs(ua - ub).max() <= 1e-9 * np.abs(ub).max()
