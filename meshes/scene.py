@@ -132,9 +132,10 @@ def _preload_libgmsh():
     path = path if os.path.exists(path) else find_library("gmsh")
     if path is None:
         return
-    libdl = ctypes.CDLL(None)  # ctypes.CDLL(path) would add RTLD_NOW without DEEPBIND's scope
-    libdl.dlopen.restype, libdl.dlopen.argtypes = ctypes.c_void_p, [ctypes.c_char_p, ctypes.c_int]
-    libdl.dlopen(path.encode(), os.RTLD_NOW | os.RTLD_LOCAL | os.RTLD_DEEPBIND)  # 0: gmsh.py's
+    try:  # kept open by the loader: gmsh.py's CDLL(path) gets the same object
+        ctypes.CDLL(path, mode=os.RTLD_LOCAL | os.RTLD_DEEPBIND)
+    except OSError:
+        pass  # gmsh.py's own load reports what is wrong
 
 
 def _gmsh_initialized(gmsh) -> bool:
