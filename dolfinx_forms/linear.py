@@ -70,6 +70,45 @@ class LinearSolverError(RuntimeError):
     """A failed linear solve (the message names the solver and PETSc's reason)."""
 
 
+class DirichletLift:
+    """Solves with J (Dirichlet rows zeroed, 1 on the diagonal, columns kept) through an operator
+    with those columns eliminated too, symmetric where J's free block is: x_D = b_D, the free
+    rows see b_F - J_FD b_D (one product with J), and the lifted values are added back.
+    Shared by the LDL^T factorisations (`Factorised`, `Condensed`) and CG (`Iterative`)."""
+
+    def __init__(self, problem):
+        self.problem = problem
+        self.lift = self.t = None  # work vectors, made on first use
+
+    def eliminated(self, J, A=None):
+        """A = J with the Dirichlet rows and columns eliminated (A None: a new matrix of J's
+        pattern, kept when the rows are zeroed, so that the next copy fits)."""
+        if A is None:
+            A = J.duplicate(copy=False)
+            A.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
+        J.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        A.zeroRowsColumns(self.problem.bc_global, diag=1.0)
+        return A
+
+    def rhs(self, J, b):
+        """(the right-hand side for the eliminated operator, whether b_D != 0 on any rank)."""
+        bc = self.problem.bc_owned
+        if not self.problem.comm.allreduce(bool(np.any(b.array[bc])), op=MPI.LOR):
+            return b, False
+        if self.lift is None:
+            self.lift, self.t = J.createVecLeft(), J.createVecLeft()
+        self.lift.zeroEntries()
+        self.lift.array[bc] = b.array[bc]
+        J.mult(self.lift, self.t)
+        self.t.aypx(-1.0, b)  # b - J lift: its Dirichlet rows are b_D - b_D = 0
+        return self.t, True
+
+    def finish(self, x, lifted):
+        """x_D = b_D after a solve of rhs(J, b)."""
+        if lifted:
+            x.axpy(1.0, self.lift)
+
+
 class Factorised:
     """KSP on the full J, the factorisation reused while J is unchanged.
 
@@ -92,23 +131,19 @@ class Factorised:
         self.key = None  # what the last factorisation was of
         self.factorisations = 0
         self.operator = 0  # the J set up last (`_OPERATORS`; 0: none)
-        self.A = self.J = self.lift = self.t = None  # symmetric: J eliminated, J, work vectors
+        self.A = self.J = None  # symmetric: J eliminated, and J (the lifting's columns)
+        self.dirichlet = DirichletLift(problem)
 
     def setup(self, J, key):
         """key: None (J changed), or a hashable description of J (the same key: same J)."""
         reuse = key is not None and key == self.key
         if self.symmetric and not reuse:
-            if self.A is None:
-                self.A = J.duplicate(copy=False)
-                self.A.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
-                self.lift, self.t = J.createVecLeft(), J.createVecLeft()
-            J.copy(self.A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-            self.A.zeroRowsColumns(self.problem.bc_global, diag=1.0)
+            self.A = self.dirichlet.eliminated(J, self.A)
             if not _symmetric(self.A):
                 self.symmetric = False  # LU on J from here on (MUMPS: the default options)
                 self.ksp.getPC().setType("lu")
                 self.ksp.getPC().setFactorSolverType("mumps")
-                self.A = self.J = self.lift = self.t = None
+                self.A = self.J = None
         self.ksp.getPC().setReusePreconditioner(reuse)
         self.key = key
         self.factorisations += not reuse
@@ -119,22 +154,12 @@ class Factorised:
         self.ksp.setOperators(self.A if self.symmetric else J)
 
     def solve(self, b, x):
-        rhs, lifted = b, False
-        if self.symmetric:
-            bc = self.problem.bc_owned
-            lifted = self.problem.comm.allreduce(bool(np.any(b.array[bc])), op=MPI.LOR)
-        if lifted:  # x_D = b_D; the free rows see -J_FD b_D
-            self.lift.zeroEntries()
-            self.lift.array[bc] = b.array[bc]
-            self.J.mult(self.lift, self.t)
-            self.t.aypx(-1.0, b)  # b - J lift: its Dirichlet rows are b_D - b_D = 0
-            rhs = self.t
+        rhs, lifted = self.dirichlet.rhs(self.J, b) if self.symmetric else (b, False)
         self.ksp.solve(rhs, x)
         reason = self.ksp.getConvergedReason()
         if reason < 0:
             raise LinearSolverError(f"linear solver diverged (reason {reason})")
-        if lifted:
-            x.axpy(1.0, self.lift)
+        self.dirichlet.finish(x, lifted)
 
 
 class Condensed:
@@ -151,6 +176,7 @@ class Condensed:
         self.problem, self.petsc_options = problem, petsc_options
         self.IS = PETSc.IS().createGeneral(np.asarray(dofs, dtype=np.int32), comm=problem.comm)
         self.bc = np.asarray(problem.bc_global, dtype=np.int32)
+        self.dirichlet, self.J = DirichletLift(problem), None  # symmetric: the lifting
         # LDL^T needs K symmetric and J - K0 inside the (c, c) block of free dofs; with
         # friction from the start (the MPM steps) J will not stay symmetric
         symmetric = problem.mu == 0 and not np.isin(self.bc, dofs).any() and _symmetric(problem.K)
@@ -167,10 +193,10 @@ class Condensed:
         t0 = time.perf_counter()
         self.F = self.base = self.S = None  # the previous factor's memory first
         self.symmetric = symmetric
-        A = self.problem.K.copy()
         if symmetric:
-            A.zeroRowsColumns(self.bc, diag=1.0)
+            A = self.dirichlet.eliminated(self.problem.K)
         else:
+            A = self.problem.K.copy()
             A.zeroRows(self.bc, diag=1.0)
         self.F, S0 = _cpp.schur_factor(A, self.IS, symmetric)
         # S = S0 + (J_cc - K0_cc) is formed in one buffer from J_cc's sparse rows: its
@@ -188,6 +214,7 @@ class Condensed:
             self.full.setup(J, key)
             self.operator = self.full.operator
             return
+        self.J = J
         if key is not None and key == self.key:
             return
         self.key = key
@@ -218,20 +245,11 @@ class Condensed:
     def solve(self, b, x):
         if self.full is not None:
             return self.full.solve(b, x)
-        bD = b.getArray(readonly=True)[self.bc]
-        if not self.symmetric or not bD.any():
+        if not self.symmetric:
             return self.F.solve(b, x)
-        # the columns eliminated from the factor: b_F - K_FD b_D (rows D keep b_D)
-        ext = b.duplicate()
-        ext.zeroEntries()
-        ext.setValues(self.bc, bD)
-        ext.assemble()
-        rhs = b.duplicate()
-        self.problem.K.mult(ext, rhs)
-        rhs.aypx(-1.0, b)
-        rhs.setValues(self.bc, bD)
-        rhs.assemble()
+        rhs, lifted = self.dirichlet.rhs(self.J, b)  # J_FD = K_FD: no contact dof is Dirichlet
         self.F.solve(rhs, x)
+        self.dirichlet.finish(x, lifted)
 
     @property
     def factorisations(self):
@@ -294,10 +312,9 @@ class Iterative:
         self.ksp.setFromOptions()
         self._true_residual()
         self.max_it = self.ksp.getTolerances()[3]
-        self.A = problem.J.duplicate(copy=False)
-        self.A.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
+        self.dirichlet = DirichletLift(problem)
+        self.A = self.dirichlet.eliminated(problem.J)
         self.A.setNearNullSpace(rigid_modes(problem))
-        self.lift, self.t = problem.J.createVecLeft(), problem.J.createVecLeft()
         self.J = None
         self.key = None
         self.operator = 0  # the J set up last (`_OPERATORS`; 0: none)
@@ -324,8 +341,7 @@ class Iterative:
             self._true_residual()
         self.key = key
         self.operator = next(_OPERATORS)
-        J.copy(self.A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        self.A.zeroRowsColumns(self.problem.bc_global, diag=1.0)
+        self.dirichlet.eliminated(J, self.A)
         self._operators(self.rebuild)
 
     def _true_residual(self):
@@ -343,15 +359,7 @@ class Iterative:
             self.fresh, self.rebuild = None, False
 
     def solve(self, b, x):
-        bc = self.problem.bc_owned
-        lifted = self.problem.comm.allreduce(bool(np.any(b.array[bc])), op=MPI.LOR)
-        rhs = b
-        if lifted:  # x_D = b_D; the free rows see -J_FD b_D
-            self.lift.zeroEntries()
-            self.lift.array[bc] = b.array[bc]
-            self.J.mult(self.lift, self.t)
-            self.t.aypx(-1.0, b)  # b - J lift: its Dirichlet rows are b_D - b_D = 0
-            rhs = self.t
+        rhs, lifted = self.dirichlet.rhs(self.J, b)
         if lifted or self.newton_target is None or self.user_rtol:
             self.ksp.setTolerances(rtol=self.rtol, atol=1e-50)
         else:  # |J du + R| <= target / 10; rtol 1e-12: a floor that CG reaches in doubles
@@ -377,8 +385,7 @@ class Iterative:
             self.fresh = its
         elif reused and its > max(self.reuse_growth * self.fresh, self.fresh + self.reuse_slack):
             self._operators(True)  # now: A is this iteration's J (the border solve follows)
-        if lifted:
-            x.axpy(1.0, self.lift)
+        self.dirichlet.finish(x, lifted)
 
     def _solve(self, rhs, x):
         t0 = time.perf_counter()
