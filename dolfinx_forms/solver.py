@@ -222,6 +222,7 @@ class ContactProblem:
             self.contact.add_zeros(self.K)
             self.K.assemble()
             self.J = self.K.duplicate(copy=False)
+            self.J_key = None  # newton._keep: the key of the tangent J holds (None: none)
             self.J.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
             # zeroRows must not shrink the pattern: MatCopy(SAME_NONZERO_PATTERN) each
             # iteration and the reuse of the symbolic LU factorisation depend on it
@@ -265,6 +266,8 @@ class ContactProblem:
     def residual(self, lam, with_tangent=False, zero_bc=True, predictor=False, stick=False):
         """R = F_bulk(u) - f(lam) + r_c(u) (owned part); with_tangent also fills self.J (with
         `predictor`, the first iteration's tangent: see predictor_gap)."""
+        if with_tangent:
+            self.J_key = None  # newton._keep: what J is the tangent of
         with self.phase("assembly"):
             self.u.x.scatter_forward()
             self.K.mult(self.u.vector, self.Ku)

@@ -169,3 +169,45 @@ def test_force_control_with_a_nonlinear_law():
     pb = mindlin(sc, "auto", {b.tag: NeoHookean(E, NU) for b in sc.bodies})
     assert pb.linear.name == "factorised"
     assert pb.reached == pytest.approx([P, 0.5 * 0.3 * P], rel=1e-9)
+
+
+@pytest.mark.parametrize("kind,enforcement", [("cut", "augmented"), ("conforming", "penalty")])
+def test_tangent_kept_while_its_key_holds(kind, enforcement, monkeypatch):
+    """newton._keep: an iteration whose key (active set, mu, force control) is the one J was
+    assembled for skips the tangent's assembly. The Mindlin path (two force controls, mu
+    switched on, slip) gives the same iterates as assembling J every iteration, with fewer
+    assemblies."""
+    from dolfinx_forms import newton
+    from dolfinx_forms.solver import ContactProblem as CP
+
+    sc = scene(kind)
+    counts = []
+
+    def counted(self, lam, with_tangent=False, **kw):
+        counts[-1] += with_tangent
+        return CP.residual.__wrapped__(self, lam, with_tangent, **kw)
+
+    counted.__wrapped__ = CP.residual
+    monkeypatch.setattr(CP, "residual", counted)
+    init = CP.__init__
+    monkeypatch.setattr(
+        CP, "__init__", lambda s, *a, **k: init(s, *a, **k, enforcement=enforcement)
+    )
+
+    def run():
+        counts.append(0)
+        return mindlin(sc, "condensed")
+
+    kept = run()
+    keep = newton._keep
+
+    def always(problem, key, lazy, lam):  # every iteration assembles J (the reference)
+        keep(problem, key, lazy, lam)
+        problem.J_key = None
+
+    monkeypatch.setattr(newton, "_keep", always)
+    ref = run()
+    assert [s.residuals for s in kept.steps] == [s.residuals for s in ref.steps]
+    assert np.array_equal(kept.u.x.array, ref.u.x.array)
+    print(f"tangent assemblies: {counts[0]} kept against {counts[1]}")
+    assert counts[0] < counts[1]
