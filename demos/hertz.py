@@ -105,6 +105,7 @@ def scene(run):
     p, cut = run.params, run.params["discretization"] == "cut"
     size = dict(R=p["R"], width=p["width"], depth=p["depth"], h=p["h"], zone=p["zone"])
     size["zone"] *= estimate(p)[1]
+    size["band"] = band(p)  # rank 0 holds the cells of Gamma_c
     # the far field coarsens with h, so that its error falls with h's (a fixed h_far: a floor)
     size["h_far"] = p["h_far"] or min(p["R"] / 2, p["depth"] / 2, 100 * p["h"])
     # body-fitted slope 0.5 instead: the same error at a/20 but a floor of 0.55 % from a/40 on
@@ -116,10 +117,15 @@ def scene(run):
 
 def problem(run):
     """Block clamped at its bottom; the cylinder top held (moved by the stages); frictionless."""
-    p, zone = run.params, 1.6 * estimate(run.params)[1]  # the band covers |x| < 1.6 a
+    p = run.params
     run.loads = dict(x=Dirichlet("cylinder_top", 0, 0.0), y=Dirichlet("cylinder_top", 1, 0.0))
     bcs = [Dirichlet("block_bottom", None, 0.0), run.loads["x"], run.loads["y"]]
-    return run.contact_problem(bcs, mu=0.0, band=p["band"] or zone ** 2 / (2 * p["R"]))
+    return run.contact_problem(bcs, mu=0.0, band=band(p))
+
+
+def band(p):
+    """The largest initial gap Gamma_c covers: --band, default the gap at x = 1.6 a."""
+    return p["band"] or (1.6 * estimate(p)[1]) ** 2 / (2 * p["R"])
 
 
 def stages(run):

@@ -374,11 +374,13 @@ def hertz_cut_scene(
     growth=1.2,
     contact_box=None,
     Ry=None,
+    band=None,
 ) -> Scene:
     """The Hertz scene of meshes/hertz.py on a graded grid (spacing h on [-z, z]^2, z = zone
     rounded up to a multiple of h); the block has no cut cell, the indenter (window
     [-R, R] x [0, Ry]) is cut by its circle, or by its ellipse of semi-axes R (horizontal) and Ry
-    (vertical, default R). contact_box overrides hertz_contact_box(R, width, depth, zone, Ry)."""
+    (vertical, default R). contact_box overrides hertz_contact_box(R, width, depth, zone, Ry,
+    band, h) (band: the contact problem's)."""
     import dolfinx_forms as df
 
     from .hertz import indenter_shape
@@ -416,7 +418,11 @@ def hertz_cut_scene(
         ("cylinder_arc", 1, None),
     ]
     markers = _window_markers([b.window for b in bodies], specs, 1e-8 * max(R, Ry, width, depth))
-    box = hertz_contact_box(R, width, depth, zone, Ry) if contact_box is None else contact_box
+    box = (
+        hertz_contact_box(R, width, depth, zone, Ry, band, h)
+        if contact_box is None
+        else contact_box
+    )
     return cut_scene(comm, xlines, ylines, bodies, markers, [(0, 1)], h, contact_box=box)
 
 

@@ -17,9 +17,11 @@ from meshes.cut import hertz_cut_scene
 from meshes.hertz import hertz_scene
 
 
-def reaction(comm, mu, disc="conforming", enforcement="penalty"):
+def reaction(comm, mu, disc="conforming", enforcement="penalty", band=0.13, box=None, **size):
+    """box: the band the scene's contact box covers (None: the scene's default)."""
     make = hertz_cut_scene if disc == "cut" else hertz_scene
-    scene = make(comm, R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.6)
+    size = {**dict(R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.6), **size}
+    scene = make(comm, **size, band=box)
     mat = {b.tag: (1e4, 0.3) for b in scene.bodies}
     top_x = Dirichlet("cylinder_top", 0, 0.0)
     top_y = Dirichlet("cylinder_top", 1, lambda lam: -0.15 * lam)
@@ -28,7 +30,7 @@ def reaction(comm, mu, disc="conforming", enforcement="penalty"):
         mat,
         mu=0.0,
         eps0=0.5,
-        band=0.13,
+        band=band,
         dirichlet=[Dirichlet("block_bottom", None, 0.0), top_x, top_y],
         enforcement=enforcement,
         log=lambda *a: None,
@@ -40,6 +42,7 @@ def reaction(comm, mu, disc="conforming", enforcement="penalty"):
         top_x.value = lambda lam: 0.01 * lam
         p.lam = 0.0
         p.solve(2)
+    reaction.owned = p.n_owned / p.num_dofs
     return p.reaction("block_bottom"), p.num_dofs
 
 
@@ -63,3 +66,22 @@ def test_two_ranks_match_one(mu, disc, enforcement):
     assert n1 == n2
     assert abs(r2[1]) > 100
     np.testing.assert_allclose(r2, r1, rtol=1e-8, atol=1e-8 * abs(r1[1]))
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("disc", ["conforming", "cut"])
+def test_wide_band_on_rank0_and_the_rest_shared(disc):
+    """The scene's contact box is the strip of Gamma_c for the problem's band
+    (meshes.hertz.hertz_contact_box): a band reaching past the fine zone (|x| < 3.1 against
+    1.8) keeps its cells on rank 0 (a fixed box failed: "closest point ... is not within ... of
+    any of its cells on this rank"), and the fine zone around the strip is shared (a square
+    around it gave rank 0 91 % of the dofs at a/20)."""
+    world = MPI.COMM_WORLD
+    assert world.size == 2, "run under mpirun -n 2"
+    size = dict(h=0.05, zone=1.2, band=0.5, box=0.5)  # the demo's h and zone (a = 1)
+    r2, n2 = reaction(world, 0.0, disc, **size)
+    share = world.allgather(reaction.owned)
+    r1, n1 = reaction(MPI.COMM_SELF, 0.0, disc, **size)
+    assert n1 == n2
+    np.testing.assert_allclose(r2, r1, rtol=1e-8, atol=1e-8 * abs(r1[1]))
+    assert max(share) < 0.65, share
