@@ -108,9 +108,10 @@ def row(run, rec):
     )
 
 
-def symmetry_error(sim, rec):
+def symmetry_error(sim, rec, h):
     """Largest relative differences under D4: contact forces (by the contact's centre) and the
-    stress at the material points (by position)."""
+    stress at the material points (by position: their images within 1e-4 h; the points move
+    with the steps, and the evolved level sets they follow are D4-symmetric to ~1e-6 mm)."""
     from scipy.spatial import cKDTree
 
     act = [q for q in rec["pairs"] if q["normal_force"] > 0]
@@ -130,16 +131,16 @@ def symmetry_error(sim, rec):
         # stresses at the points whose image is a point: those of the interior cells' tensor
         # Gauss rule (the cut cells' sub-triangle rule is not D4-invariant)
         d, k = tx.query(x @ G.T)
-        same = d < 1e-9 * np.abs(x).max()
+        same = d < 1e-4 * h
         Sg = np.einsum("ab,nbc,dc->nad", G, S, G)
-        e_s = max(e_s, np.max(np.abs(S[k[same]] - Sg[same])))
+        e_s = max(e_s, np.max(np.abs(S[k[same]] - Sg[same]), initial=0.0))
         n_same = min(n_same, int(same.sum())) if G is not D4[0] else int(same.sum())
     return e_f / fn.max(), e_s / np.abs(S).max(), e_x, n_same / len(x)
 
 
 def evaluate(run):
     sim, rec = run.sim, run.records[-1]
-    e_f, e_s, e_x, frac = symmetry_error(sim, rec)
+    e_f, e_s, e_x, frac = symmetry_error(sim, rec, run.params["h"])
     forces = np.array([v[:2] for v in rec["body_forces"].values()])
     fmax = max(q["normal_force"] for q in rec["pairs"])
     eq = equilibrium_error(rec)  # contacts + supports (the plates' outer faces)
