@@ -29,10 +29,11 @@ def test_defaults_are_symmetric_and_balanced(tmp_path):
 
 
 def test_later_steps_report_their_symmetry(tmp_path):
-    """Two steps: the material points have moved with the evolved level sets (D4-symmetric to
-    ~1e-6 mm, not to round-off), so mirror points are paired within 1e-4 h (the pairing to 1e-9
-    of |x| found none and ended in a traceback). The figures are finite and reported; a
-    symmetry lost beyond 1e-6 is a warning, not an exit 0 in silence."""
+    """Two steps: the second step's stress comes from the MLS projection of point sets that
+    are not D4-invariant (cut cells), so the points move D4-symmetrically only to ~1e-6 mm and
+    mirror points are paired within 1e-4 h (the pairing to 1e-9 of |x| found none and ended in
+    a traceback). The figures are finite and reported; a symmetry lost beyond 1e-6 is a
+    warning, not an exit 0 in silence."""
     out = tmp_path / "nine2"
     assert demo.main(["--out", str(out), "--steps", "2"]) == 0
     m = json.load(open(out / "metrics.json"))
