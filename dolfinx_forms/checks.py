@@ -21,6 +21,11 @@ them) and returns, on every rank, one line per failed check:
   MPM, which runs the penalty only): half-widths 0.62-0.75 against the stiff penalty's
   0.33-0.35, the force 9-18 % low.
 
+* unheld body: a body with no closed contact point and Dirichlet conditions on fewer than both
+  displacement components (none: all three rigid motions) and no rigid-mode springs. Its
+  stiffness is singular: the linear solver returned one of the many solutions (a free block
+  came back "converged" in 5 Newton iterations, exit 0) and its position means nothing.
+
 The demos put them in metrics.json (`solver.warnings`) and on the console, with the largest
 penetration (`penetration`): point-wise, and as the law points' (with traction "points", the
 multiplier nodes') weighted mean gap, which is what the augmented enforcement's multipliers
@@ -95,7 +100,43 @@ def contact_warnings(problem):
     for k, (g, s) in enumerate(zip(cs.pairs, cs.committed)):
         if s is not None:
             mine += pair_warnings(g, s, problem.scene.h_contact, problem.band, "-".join(names[k]))
-    return [w for part in problem.comm.allgather(mine) for w in part]
+    return [w for part in problem.comm.allgather(mine) for w in part] + unheld_bodies(problem)
+
+
+def unheld_bodies(problem):
+    """One line per body that nothing holds at the committed state (module doc), the same on
+    every rank."""
+    from mpi4py import MPI
+
+    if problem.rigid_mode_stiffness > 0:
+        return []
+    bodies = problem.scene.bodies
+    touching = np.zeros(len(bodies), np.int32)  # a closed contact point
+    for g, s in zip(problem.contact.pairs, problem.contact.committed):
+        if s is not None and np.any(s["state"] > 0):
+            touching[g.pair[0]] = 1
+            if g.obstacle is None:
+                touching[g.pair[1]] = 1
+    touching = problem.comm.allreduce(touching, op=MPI.SUM) > 0  # arrays: elementwise sum
+    bs = problem.bs
+    bc = np.unique(np.concatenate(problem.bc_dofs)) if problem.bc_dofs else np.zeros(0, int)
+    dofmap = problem.V.dofmap.list.array.reshape(-1, problem.V.dofmap.dof_layout.num_dofs)
+    held = np.zeros((len(bodies), bs), np.int32)  # a Dirichlet condition per component
+    for k, b in enumerate(bodies):
+        nodes = np.unique(dofmap[problem.scene.cell_tags.find(b.tag)])
+        dofs = (nodes[:, None] * bs + np.arange(bs)).ravel()
+        held[k] = np.isin(dofs, bc).reshape(-1, bs).any(axis=0)
+    held = problem.comm.allreduce(held, op=MPI.SUM) > 0
+    out = []
+    for k, b in enumerate(bodies):
+        if not touching[k] and not held[k].all():
+            free = "its rigid motions are" if not held[k].any() else "its rigid motion is"
+            out.append(
+                f"{b.name}: held by nothing (no closed contact point, Dirichlet conditions on "
+                f"{int(held[k].sum())} of {bs} components): {free} undetermined, the linear "
+                "solver returned one of many solutions (hold it, or close its contacts)"
+            )
+    return out
 
 
 def penetration(problem):

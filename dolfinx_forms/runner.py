@@ -348,6 +348,8 @@ def run(
             r.analytic.update(an)
         r.metrics["checks"] = evaluate_checks(r.metrics, spec["checks"])
         r.metrics["checks_passed"] = all(c["passed"] for c in r.metrics["checks"])
+        for w in r.metrics["solver"]["warnings"]:  # as the demos print them
+            log(f"WARNING: {w}")
         for c in r.metrics["checks"]:
             log(
                 f"check {c['label']}: {'ok' if c['passed'] else 'FAILED'} "

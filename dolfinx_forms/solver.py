@@ -118,6 +118,7 @@ class ContactProblem:
         self.timer = timer
         self.log = log if self.comm.rank == 0 else (lambda *a, **k: None)
         self.predictor_gap = float(predictor_gap)
+        self.rigid_mode_stiffness = float(rigid_mode_stiffness)  # checks.unheld_bodies
         self.laws = {int(t): as_law(m) for t, m in materials.items()}
         self.materials = self.laws
 

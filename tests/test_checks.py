@@ -108,3 +108,28 @@ def test_contact_over_every_multiplier_node_is_not_under_resolved(tmp_path):
     m = json.loads((out / "metrics.json").read_text())
     assert m["results"]["pressure_rel_error_vs_exact"] <= 1e-8
     assert m["solver"]["warnings"] == []
+
+
+def test_a_body_held_by_nothing_is_reported(tmp_path):
+    """demos/scenes/two_blocks.toml without the upper block's Dirichlet conditions: the side
+    loads lift the lower block, no contact point closes, the upper block is free. Newton still
+    "converges" (MUMPS returns one of the singular system's solutions); the check says that
+    its position means nothing, in metrics.json and on the console."""
+    text = (ROOT / "demos" / "scenes" / "two_blocks.toml").read_text()
+    a, b = text.index('[[dirichlet]]\nname = "top_x"'), text.index("[[tractions]]")
+    text = text[:a] + text[b:]
+    text = text.replace('[outputs]\nreaction = "upper_top"\n', "[outputs]\n")
+    text = text[: text.index("[[checks]]")]
+    scene = tmp_path / "free.toml"
+    scene.write_text(text)
+    out = tmp_path / "free"
+    r = subprocess.run(
+        [sys.executable, "-m", "dolfinx_forms", "run", str(scene), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
+    assert r.returncode == 0, r.stderr
+    (w,) = json.loads((out / "metrics.json").read_text())["solver"]["warnings"]
+    assert w.startswith("upper: held by nothing") and "0 of 2 components" in w
+    assert f"WARNING: {w}" in r.stdout
