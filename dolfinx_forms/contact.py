@@ -381,6 +381,10 @@ class BodyLocator:
         return self.element.tabulate(0, X)[0, :, :, 0]
 
 
+# the own grid cell first, then its 8 neighbours (GridLocator.locate)
+NEIGHBOURS = [(0, 0)] + [(di, dj) for di in (0, -1, 1) for dj in (0, -1, 1) if di or dj]
+
+
 class GridLocator:
     """Point location among one body's active cells of a cut scene's structured grid: the grid
     index of a point is found by bisection on the tensor lines and looked up in a table (no
@@ -429,19 +433,20 @@ class GridLocator:
         i, j = self._index(p)
         best = np.full(len(p), -1, np.int32)
         dist = np.full(len(p), np.inf)
-        for di in (0, -1, 1):  # own grid cell first; neighbours only where it is inactive
-            for dj in (0, -1, 1):
-                ii = np.clip(i + di, 0, self.table.shape[0] - 1)
-                jj = np.clip(j + dj, 0, self.table.shape[1] - 1)
-                k = self.table[ii, jj]
-                ok = k >= 0
-                d = np.full(len(p), np.inf)
-                d[ok] = np.linalg.norm(
-                    np.maximum(0, np.maximum(self.lo[k[ok]] - p[ok], p[ok] - self.hi[k[ok]])),
-                    axis=1,
-                )
-                better = d < dist
-                best[better], dist[better] = k[better], d[better]
+        rest = np.arange(len(p))  # the points not yet inside a cell (distance 0)
+        for di, dj in NEIGHBOURS:  # own grid cell first; neighbours only where it is inactive
+            ii = np.clip(i[rest] + di, 0, self.table.shape[0] - 1)
+            jj = np.clip(j[rest] + dj, 0, self.table.shape[1] - 1)
+            k = self.table[ii, jj]
+            ok = k >= 0
+            d = np.full(len(rest), np.inf)
+            q = p[rest[ok]]
+            d[ok] = np.linalg.norm(
+                np.maximum(0, np.maximum(self.lo[k[ok]] - q, q - self.hi[k[ok]])), axis=1
+            )
+            better = d < dist[rest]
+            best[rest[better]], dist[rest[better]] = k[better], d[better]
+            rest = rest[dist[rest] > 0]  # a cell at distance 0 cannot be bettered
         found = (best >= 0) & (dist <= max_distance)
         k = np.where(found, best, 0)
         r = p - self.v0[k]

@@ -330,3 +330,15 @@ def test_stick_predictor_shear_step():
     assert all(p["stick_fraction"] == 1.0 for p in fast["pairs"])
     fx = fast["obstacles"]["top"]["fx"]
     assert fx < 0 and fx == pytest.approx(slow["obstacles"]["top"]["fx"], rel=1e-8)
+
+
+def test_q1_basis_is_basix_q1():
+    """material_points.q1_basis (closed form, the points' displacement) against basix's Q1
+    element, values and first derivatives, inside the square and extrapolated outside."""
+    import basix
+
+    from dolfinx_forms.material_points import q1_basis
+
+    X = np.random.default_rng(0).uniform(-0.3, 1.3, (200, 2))
+    el = basix.create_element(basix.ElementFamily.P, basix.CellType.quadrilateral, 1)
+    assert np.abs(q1_basis(X) - el.tabulate(1, X)[:, :, :, 0]).max() < 1e-14
