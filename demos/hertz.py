@@ -24,7 +24,7 @@ from dolfinx_forms.demo import run_case
 from dolfinx_forms.protocol import friction_on, reach_force
 from dolfinx_forms.solver import Dirichlet
 from meshes.cut import hertz_cut_scene
-from meshes.hertz import hertz_scene
+from meshes.hertz import hertz_scene, mesh_size_bounds
 
 PROTOCOL = (
     "rigid approach of the cylinder top, frictionless, iterated to the load P; "
@@ -83,10 +83,10 @@ def parse(argv):
             f"Hertz half-width of --load, --R, --E), must lie inside both bodies: "
             f"below {name.lstrip('-')}{'/2' if name == '--width' else ''} = {room[name]:.4g}"
         )
-    lo = max(zone / 2000, 1e-5 * max(a.R, a.width, a.depth))  # cells and grading gmsh can do
-    if not lo <= a.h <= zone / 2:
+    lo, hi = mesh_size_bounds(a.R, a.width, a.depth, zone)  # cells and grading gmsh can do
+    if not lo <= a.h <= hi:
         p.error(
-            f"{given}: h = {a.h:.4g} outside [{lo:.4g}, {zone / 2:.4g}] (at least 1/2000 of the "
+            f"{given}: h = {a.h:.4g} outside [{lo:.4g}, {hi:.4g}] (at least 1/2000 of the "
             f"zone's half-width {zone:.4g} and 1e-5 of the largest body size "
             f"{max(a.R, a.width, a.depth):.4g}, at most half the zone; a small load needs "
             "smaller --R, --width, --depth)"

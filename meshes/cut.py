@@ -45,7 +45,7 @@ from dolfinx_forms.cut import (  # noqa: F401
     shape_values,
 )
 
-from .hertz import hertz_contact_box
+from .hertz import check_mesh_size, hertz_contact_box
 from .scene import Body, Scene, on_box_side, partitioner_kwargs, summary, tag_boundaries
 
 __all__ = [
@@ -386,6 +386,7 @@ def hertz_cut_scene(
     from .hertz import indenter_shape
 
     Ry = R if Ry is None else float(Ry)
+    check_mesh_size(R, width, depth, h, zone, Ry)
     W = width / 2
     k = zone / h
     z = zone if abs(k - round(k)) < 1e-9 else h * np.ceil(k)

@@ -51,6 +51,32 @@ def hertz_contact_box(R=10.0, width=40.0, depth=20.0, zone=1.5, Ry=None, band=No
     )
 
 
+def mesh_size_bounds(R, width, depth, zone, Ry=None):
+    """The mesh sizes h the Hertz scenes can mesh, (lo, hi): at least 1/2000 of the zone's
+    half-width and 1e-5 of the largest body size (below, gmsh runs out of memory or aborts, the
+    grid of the cut path likewise), at most half the zone. ValueError if the zone does not lie
+    inside both bodies (zone < min(R, Ry, width/2, depth))."""
+    Ry = R if Ry is None else Ry
+    room = min(R, Ry, width / 2, depth)
+    if not 0 < zone < room:
+        raise ValueError(
+            f"zone {zone:.4g} must lie inside both bodies: in (0, min(R, Ry, width/2, depth) = "
+            f"{room:.4g})"
+        )
+    return max(zone / 2000, 1e-5 * max(R, Ry, width, depth)), zone / 2
+
+
+def check_mesh_size(R, width, depth, h, zone, Ry=None):
+    """ValueError unless h is within `mesh_size_bounds` (a library caller gets the message
+    instead of a gmsh abort or a mesh of 1e14 cells)."""
+    lo, hi = mesh_size_bounds(R, width, depth, zone, Ry)
+    if not lo <= h <= hi:
+        raise ValueError(
+            f"h = {h:.4g} outside [{lo:.4g}, {hi:.4g}] (at least 1/2000 of the zone's half-width "
+            f"{zone:.4g} and 1e-5 of the largest body size, at most half the zone)"
+        )
+
+
 def ellipse_sag(R, Ry, x):
     """Height of the arc above its lowest point at abscissa x: Ry (1 - sqrt(1 - (x/R)^2)) (the
     initial gap to the block top; R - sqrt(R^2 - x^2) for the circle Ry = R)."""
@@ -183,6 +209,7 @@ def hertz_scene(
     import dolfinx_forms as df
 
     Ry = R if Ry is None else float(Ry)
+    check_mesh_size(R, width, depth, h, zone, Ry)
     h_far = max(h, min(R, Ry, depth) / 8 if h_far is None else h_far)
     W = width / 2
     bodies = [

@@ -287,3 +287,20 @@ def test_build_error_raises_on_all_ranks():
     with pytest.raises((AssertionError, RuntimeError)):
         hertz_scene(comm, h=0.2, zone=50.0)  # zone larger than the bodies: fails on rank 0
     comm.Barrier()
+
+
+@pytest.mark.parametrize("kind", ["conforming", "cut"])
+def test_hertz_scenes_refuse_sizes_they_cannot_mesh(kind):
+    """h outside meshes.hertz.mesh_size_bounds, or a zone outside a body: a ValueError before
+    any meshing (hertz_scene(h=1e-7) ran gmsh for minutes towards 1e14 cells)."""
+    from meshes.cut import hertz_cut_scene
+    from meshes.hertz import mesh_size_bounds
+
+    make = hertz_cut_scene if kind == "cut" else hertz_scene
+    lo, hi = mesh_size_bounds(10.0, 40.0, 20.0, 1.5)
+    assert (lo, hi) == (1.5 / 2000, 0.75)
+    for h in (1e-7, 0.9 * lo, 1.1 * hi):
+        with pytest.raises(ValueError, match="outside"):
+            make(MPI.COMM_SELF, h=h)
+    with pytest.raises(ValueError, match="inside both bodies"):
+        make(MPI.COMM_SELF, h=0.5, zone=12.0)
