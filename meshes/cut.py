@@ -46,7 +46,15 @@ from dolfinx_forms.cut import (  # noqa: F401
 )
 
 from .hertz import check_mesh_size, hertz_contact_box
-from .scene import Body, Scene, on_box_side, partitioner_kwargs, summary, tag_boundaries
+from .scene import (
+    Body,
+    Scene,
+    check_cells,
+    on_box_side,
+    partitioner_kwargs,
+    summary,
+    tag_boundaries,
+)
 
 __all__ = [
     "CutBody",
@@ -433,6 +441,7 @@ def patch_cut_scene(comm, n=5, width=1.0, height=1.0, interface=0.5, nx=None) ->
     height]; `interface` must not be a grid line (ValueError): the test wants cut cells. The
     default n = 5 keeps the gmsh patch's interface 0.5 mid-cell."""
     nx = max(1, round(n * width / height)) if nx is None else int(nx)
+    check_cells("patch_cut_scene", nx * n if n > 0 else 0, "fewer cells")
     xlines, ylines = np.linspace(0.0, width, nx + 1), np.linspace(0.0, height, n + 1)
     hy = height / n
     k = interface / hy
@@ -476,6 +485,7 @@ def two_blocks_cut_scene(comm, h=0.2, width_lower=40.0, height=10.0, width_upper
     """The two blocks of meshes/two_blocks.py on a uniform grid: x lines through 0, c -+
     width_upper/2, width_lower (spacing <= about h), ny = the smallest odd integer >= 2 height / h
     cells over [0, 2 height], so the interface y = height is mid-cell."""
+    check_cells("two_blocks_cut_scene", 2 * height * width_lower / h**2 if h > 0 else 0)
     c = width_lower / 2
     req = np.array([0.0, c - width_upper / 2, c + width_upper / 2, width_lower])
     gap = np.diff(np.unique(req))
@@ -530,6 +540,7 @@ def incline_cut_scene(comm, h=25.0, size=1000.0, slope=0.2, intercept=458.6) -> 
     y0, y1 = intercept, slope * size + intercept
     if not (0 < y0 < size and 0 < y1 < size):
         raise ValueError("incline_cut_scene: the line must cross both vertical sides")
+    check_cells("incline_cut_scene", (size / h) ** 2 if h > 0 else 0)
     n = max(1, round(size / h))
     lines = np.linspace(0.0, size, n + 1)
     square = np.array([[0.0, 0.0], [size, size]])

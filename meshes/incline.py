@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .scene import Body, Scene, add_polygon, gmsh_model, scene_from_gmsh, summary
+from .scene import Body, Scene, add_polygon, check_cells, gmsh_model, scene_from_gmsh, summary
 
 
 def incline_scene(comm, h=25.0, quads=False, size=1000.0, slope=0.2, intercept=458.6) -> Scene:
@@ -23,6 +23,7 @@ def incline_scene(comm, h=25.0, quads=False, size=1000.0, slope=0.2, intercept=4
 
     y0, y1 = intercept, slope * size + intercept
     assert 0 < y0 < size and 0 < y1 < size, "the line must cross both vertical sides"
+    check_cells("incline_scene", 2 * (size / h) ** 2 if h > 0 else 0.0)
     polys = [
         np.array([[0, 0], [size, 0], [size, y1], [0, y0]]),
         np.array([[0, y0], [size, y1], [size, size], [0, size]]),

@@ -14,7 +14,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from .scene import Body, Scene, add_polygon, gmsh_model, on_box_side, scene_from_gmsh, summary
+from .scene import (
+    Body,
+    Scene,
+    add_polygon,
+    check_cells,
+    gmsh_model,
+    on_box_side,
+    scene_from_gmsh,
+    summary,
+)
 
 NAMES = ("lower", "upper")  # body 0, body 1
 
@@ -23,6 +32,9 @@ def patch_scene(comm, nx=4, ny=2, quads=True, width=1.0, height=0.5, nx_upper=No
     import dolfinx_forms as df
 
     nx_upper = nx if nx_upper is None else nx_upper
+    check_cells(
+        "patch_scene", (nx + nx_upper) * ny if min(nx, nx_upper, ny) > 0 else 0, "fewer cells"
+    )
     boxes = [
         np.array([[0.0, 0.0], [width, height]]),
         np.array([[0.0, height], [width, 2 * height]]),

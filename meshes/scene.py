@@ -41,6 +41,7 @@ __all__ = [
     "Scene",
     "scene_from_gmsh",
     "gmsh_model",
+    "check_cells",
     "contact_partitioner",
     "cell_bboxes",
     "add_polygon",
@@ -60,6 +61,19 @@ __all__ = [
 # 2 h_contact) and locates closest points up to h_contact / 2 outside a cell: 4 covers it. A
 # larger band needs an explicit contact_box.
 CONTACT_BOX_MARGIN = 4.0
+# the most cells a scene builder makes: ~2e7 quadrilaterals are ~4e7 dofs, beyond any 2D run
+# this code is measured on (1e6 dofs take 2-3.5 GB); above it gmsh or numpy would run for
+# minutes or abort on memory instead of a message (`check_cells`)
+MAX_CELLS = 2e7
+
+
+def check_cells(builder, cells, hint="use a larger h"):
+    """ValueError unless 0 < cells <= MAX_CELLS (an estimate of the cells `builder` would make,
+    checked before any meshing or allocation)."""
+    if not 0 < cells <= MAX_CELLS:
+        raise ValueError(
+            f"{builder}: the sizes give ~{cells:.3g} cells, outside (0, {MAX_CELLS:.0e}] ({hint})"
+        )
 
 
 @dataclass

@@ -16,7 +16,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from .scene import Body, Scene, add_polygon, gmsh_model, on_box_side, scene_from_gmsh, summary
+from .scene import (
+    Body,
+    Scene,
+    add_polygon,
+    check_cells,
+    gmsh_model,
+    on_box_side,
+    scene_from_gmsh,
+    summary,
+)
 
 NAMES = ("lower", "upper")  # body 0, body 1
 
@@ -26,6 +35,7 @@ def two_blocks_scene(
 ) -> Scene:
     import dolfinx_forms as df
 
+    check_cells("two_blocks_scene", height * (width_lower + width_upper) / h**2 if h > 0 else 0)
     c = width_lower / 2
     boxes = [
         np.array([[0.0, 0.0], [width_lower, height]]),

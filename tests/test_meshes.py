@@ -304,3 +304,24 @@ def test_hertz_scenes_refuse_sizes_they_cannot_mesh(kind):
             make(MPI.COMM_SELF, h=h)
     with pytest.raises(ValueError, match="inside both bodies"):
         make(MPI.COMM_SELF, h=0.5, zone=12.0)
+
+
+@pytest.mark.parametrize(
+    "module, builder, kwargs",
+    [
+        ("meshes.incline", "incline_scene", dict(h=1e-6)),
+        ("meshes.two_blocks", "two_blocks_scene", dict(h=1e-6)),
+        ("meshes.patch", "patch_scene", dict(nx=10**6, ny=10**6)),
+        ("meshes.cut", "incline_cut_scene", dict(h=1e-6)),
+        ("meshes.cut", "two_blocks_cut_scene", dict(h=1e-6)),
+        ("meshes.cut", "patch_cut_scene", dict(n=10**5, nx=10**5)),
+    ],
+)
+def test_scene_builders_refuse_more_cells_than_they_can_hold(module, builder, kwargs):
+    """meshes.scene.check_cells: an estimate of the cells above MAX_CELLS is a ValueError naming
+    the builder, before gmsh or numpy start (they ran for minutes or died on memory)."""
+    import importlib
+
+    make = getattr(importlib.import_module(module), builder)
+    with pytest.raises(ValueError, match=f"{builder}: the sizes give"):
+        make(MPI.COMM_SELF, **kwargs)
