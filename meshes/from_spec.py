@@ -173,10 +173,12 @@ def _grid_lines(d, windows):
     from .cut import graded_lines
 
     h, ext, lines = d["h"], np.asarray(d["extent"], float), []
+    key = "discretization.cells" if d["fine"] is None and d["cells"] else "discretization.h"
     for ax in range(2):
         a, b = ext[:, ax]
         if d["fine"] is None:
             n = d["cells"][ax] if d["cells"] else max(1, round((b - a) / h))
+            _check_cells(key, n)  # before the lines are allocated
             lines.append(np.linspace(a, b, n + 1))
             continue
         req = sorted({w[k][ax] for w in windows for k in (0, 1) if a < w[k][ax] < b})
@@ -184,6 +186,7 @@ def _grid_lines(d, windows):
         c0, c1 = h * math.floor(f0 / h + 1e-9), h * math.ceil(f1 / h - 1e-9)
         c0, c1 = (a, c1) if c0 < a else (c0, c1)
         c0, c1 = (c0, b) if c1 > b else (c0, c1)
+        _check_cells(key, abs(c1 - c0) / h)  # the fine lines alone
         try:
             lines.append(
                 graded_lines(
@@ -192,7 +195,18 @@ def _grid_lines(d, windows):
             )
         except ValueError as e:
             raise _error("discretization", f"{'xy'[ax]} lines: {e}") from None
+    _check_cells(key, (len(lines[0]) - 1) * (len(lines[1]) - 1))
     return lines
+
+
+def _check_cells(key, cells):
+    """SpecError at `key` for more cells than a scene builder makes (meshes.scene.MAX_CELLS)."""
+    from .scene import check_cells
+
+    try:
+        check_cells("the scene", cells, "a larger h or fewer cells")
+    except ValueError as e:
+        raise _error(key, str(e)) from None
 
 
 def _snap(lines, lo, hi, tol):
@@ -319,6 +333,7 @@ def _fitted_scene(comm, spec):
     fine = np.asarray(d["fine"], float) if d["fine"] is not None else box
     if fine is None:
         fine = np.array([np.min(bboxes, axis=(0, 1)), np.max(bboxes, axis=(0, 1))])
+    _check_cells("discretization.h", np.prod(np.ptp(fine, axis=0)) / h**2)  # the zone at h
     tol = 1e-8 * _scale(spec)
     names = [b["name"] for b in spec["bodies"]]
     pairs = [(names.index(a), names.index(b)) for a, b in spec["pairs"]]

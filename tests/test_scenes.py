@@ -126,6 +126,9 @@ def test_failed_check(tmp_path):
         (["--set", "stages=[{kind='ramp', to={nope=1.0}}]"], "stages[0].to.nope"),
         (["--set", "bodies[0].window=[[0.0,0.0],[1.0,0.6]]"], "bodies[0].window"),  # the grid
         (["--set", "dirichlet[2].point=[0.1,0.0]"], "dirichlet[2].point"),  # the mesh
+        # more cells than a builder makes (meshes.scene.MAX_CELLS): was a numpy MemoryError
+        (["--set", "discretization.h=1e-7"], "discretization.h"),
+        (["--set", "discretization.cells=[100000,100000]"], "discretization.cells"),
     ],
 )
 def test_bad_description(tmp_path, args, key):
