@@ -21,10 +21,11 @@ them) and returns, on every rank, one line per failed check:
   MPM, which runs the penalty only): half-widths 0.62-0.75 against the stiff penalty's
   0.33-0.35, the force 9-18 % low.
 
-* unheld body: a body with no closed contact point and Dirichlet conditions on fewer than both
-  displacement components (none: all three rigid motions) and no rigid-mode springs. Its
-  stiffness is singular: the linear solver returned one of the many solutions (a free block
-  came back "converged" in 5 Newton iterations, exit 0) and its position means nothing.
+* unheld body: a rigid motion of a body (a translation, or the rotation about its centre) that
+  the last tangent does not resist (no Dirichlet condition, closed contact or rigid-mode
+  spring: a free block, or a frictionless block held vertically only on a flat face). The
+  stiffness is singular: the linear solver returned one of many solutions (a free block came
+  back "converged" in 5 Newton iterations, exit 0) and that motion means nothing.
 
 The demos put them in metrics.json (`solver.warnings`) and on the console, with the largest
 penetration (`penetration`): point-wise, and as the law points' (with traction "points", the
@@ -35,8 +36,12 @@ between nodes is the P1 trace's discretisation error).
 """
 
 import numpy as np
+from petsc4py import PETSc
 
 PENETRATION = 0.1  # of h_contact
+# |J r| / (|J|_inf |r|) of an unresisted rigid motion: round-off, ~1e-16 on a free block; a
+# held one measured 1.8e-5 (Hertz block, clamped at its bottom) or more
+RIGID_RTOL = 1e-9
 MIN_NODES = 7  # multiplier nodes with pressure, below which a zone is under-resolved
 
 
@@ -104,37 +109,58 @@ def contact_warnings(problem):
 
 
 def unheld_bodies(problem):
-    """One line per body that nothing holds at the committed state (module doc), the same on
-    every rank."""
+    """One line per body with a rigid motion that nothing holds at the committed state (module
+    doc), the same on every rank: r (x or y translation, rotation about the body's centre) on
+    the body's dofs with |J r| <= RIGID_RTOL |J| |r|, J the last tangent (Dirichlet rows kept
+    as identity rows, the contact tangent of the settled active set). All bodies' motions are
+    the columns of one sparse R and J R one product (a few nnz(J) flops: an MPM step of many
+    grains pays it per step)."""
     from mpi4py import MPI
 
     if problem.rigid_mode_stiffness > 0:
         return []
+    comm, J, bs, V = problem.comm, problem.J, problem.bs, problem.V
+    n_own = V.dofmap.index_map.size_local
+    X = V.tabulate_dof_coordinates()[:n_own, :2]
+    dofmap = V.dofmap.list.array.reshape(-1, V.dofmap.dof_layout.num_dofs)
     bodies = problem.scene.bodies
-    touching = np.zeros(len(bodies), np.int32)  # a closed contact point
-    for g, s in zip(problem.contact.pairs, problem.contact.committed):
-        if s is not None and np.any(s["state"] > 0):
-            touching[g.pair[0]] = 1
-            if g.obstacle is None:
-                touching[g.pair[1]] = 1
-    touching = problem.comm.allreduce(touching, op=MPI.SUM) > 0  # arrays: elementwise sum
-    bs = problem.bs
-    bc = np.unique(np.concatenate(problem.bc_dofs)) if problem.bc_dofs else np.zeros(0, int)
-    dofmap = problem.V.dofmap.list.array.reshape(-1, problem.V.dofmap.dof_layout.num_dofs)
-    held = np.zeros((len(bodies), bs), np.int32)  # a Dirichlet condition per component
+    body = np.full(n_own, -1)  # the body of each owned node (bodies are disjoint)
     for k, b in enumerate(bodies):
         nodes = np.unique(dofmap[problem.scene.cell_tags.find(b.tag)])
-        dofs = (nodes[:, None] * bs + np.arange(bs)).ravel()
-        held[k] = np.isin(dofs, bc).reshape(-1, bs).any(axis=0)
-    held = problem.comm.allreduce(held, op=MPI.SUM) > 0
+        body[nodes[nodes < n_own]] = k
+    count = comm.allreduce(np.bincount(body[body >= 0], minlength=len(bodies)), op=MPI.SUM)
+    sums = np.zeros((len(bodies), 2))
+    np.add.at(sums, body[body >= 0], X[body >= 0])
+    centre = comm.allreduce(sums, op=MPI.SUM) / np.maximum(count, 1)[:, None]
+    # R: a row per owned dof, the columns 3 k + (x, y, rotation) of its body k
+    held = body >= 0
+    d = X - centre[np.maximum(body, 0)]
+    vals = np.zeros((n_own, bs, 3))
+    vals[:, 0, 0] = vals[:, 1, 1] = 1.0
+    vals[:, 0, 2], vals[:, 1, 2] = -d[:, 1], d[:, 0]
+    vals[~held] = 0.0
+    cols = 3 * np.maximum(body, 0)[:, None, None] + np.arange(3)[None, None, :]
+    cols = np.broadcast_to(cols, vals.shape).reshape(-1, 3).astype(PETSc.IntType)
+    ptr = np.arange(0, 3 * n_own * bs + 1, 3, dtype=PETSc.IntType)
+    R = PETSc.Mat().createAIJ(
+        ((n_own * bs, None), (None, 3 * len(bodies))),
+        csr=(ptr, cols.ravel(), vals.reshape(-1, 3).ravel()),
+        comm=comm,
+    )
+    _, yj, yv = J.matMult(R).getValuesCSR()  # this rank's rows, global columns
+    Jr2 = comm.allreduce(np.bincount(yj, yv**2, 3 * len(bodies)), op=MPI.SUM)
+    r2 = comm.allreduce(np.bincount(cols.ravel(), vals.ravel() ** 2, 3 * len(bodies)), MPI.SUM)
+    R.destroy()
+    norm = J.norm(PETSc.NormType.INFINITY)
+    free = (r2 > 0) & (np.sqrt(Jr2) <= RIGID_RTOL * norm * np.sqrt(r2))
     out = []
     for k, b in enumerate(bodies):
-        if not touching[k] and not held[k].all():
-            free = "its rigid motions are" if not held[k].any() else "its rigid motion is"
+        names = [n for m, n in enumerate(("x", "y", "rotation")) if free[3 * k + m]]
+        if names:
             out.append(
-                f"{b.name}: held by nothing (no closed contact point, Dirichlet conditions on "
-                f"{int(held[k].sum())} of {bs} components): {free} undetermined, the linear "
-                "solver returned one of many solutions (hold it, or close its contacts)"
+                f"{b.name}: held by nothing in {', '.join(names)} (no Dirichlet condition or "
+                "closed contact resists that rigid motion): the solve returned one of many "
+                "solutions (hold it, or close its contacts)"
             )
     return out
 
