@@ -183,7 +183,7 @@ def displacement_at(problem, tag, points, max_distance):
 def q1_basis(X):
     """The Q1 basis on the reference square in DOLFINx's (basix's) order (0,0), (1,0), (0,1),
     (1,1) at reference points X (n, 2) (extrapolated outside): values, d/dX and d/dY, (3, n, 4).
-    Closed form: 3x faster than basix's tabulate (17 ms for the Brazilian disc's points)."""
+    Closed form: ~1 ms for the Brazilian disc's 70k points, basix's tabulate 5-60 ms."""
     x, y = X[:, 0], X[:, 1]
     t = np.empty((3, len(X), 4))
     t[0, :, 0], t[0, :, 1] = (1 - x) * (1 - y), x * (1 - y)
