@@ -83,6 +83,8 @@ class DemoParser(argparse.ArgumentParser):
             opts = petsc_options(self, getattr(a, self._petsc_dest), defaults)
             setattr(a, self._petsc_dest, opts)
         given = sys.argv[1:] if args is None else args
+        if getattr(a, "multiplier_mass", "lumped") != "lumped" and a.enforcement != "augmented":
+            self.error("--multiplier-mass: needs --enforcement augmented (the penalty has none)")
         if (
             getattr(a, "enforcement", None) == "augmented"
             and hasattr(a, "eps0")
@@ -439,6 +441,17 @@ def add_enforcement(parser, choices=("penalty", "augmented")):
             else "contact enforcement: the multi-step MPM runs the penalty only"
         ),
     )
+    if "augmented" in choices:
+        parser.add_argument(
+            "--multiplier-mass",
+            choices=["lumped", "consistent"],
+            default="lumped",
+            help=(
+                "--enforcement augmented: Uzawa's projection of the point tractions on the P1 "
+                "multipliers, lumped (the closer pressure) or consistent (zero weighted mean "
+                "gap at every node in contact, a coarser pressure) (default: lumped)"
+            ),
+        )
 
 
 def add_linear_solver(parser):

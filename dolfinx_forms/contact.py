@@ -37,6 +37,9 @@ from .obstacles import RigidObstacle
 
 # where the law acts when the pair has multiplier nodes (`PairGeometry.traction`)
 TRACTIONS = ("nodes", "points")
+# the mass matrix of Uzawa's projection of point tractions on P1 multiplier nodes with
+# traction "points" (`PairGeometry.node_multipliers`)
+MULTIPLIER_MASSES = ("lumped", "consistent")
 
 
 @dataclass
@@ -62,6 +65,9 @@ class PairGeometry:
     # where the law acts with multiplier nodes: "nodes" (on their weighted mean gaps) or
     # "points" (at each point, the multipliers interpolated there: `pair_geometry`'s traction)
     traction: str = "nodes"
+    # with traction "points": "lumped" (each node the hat-weighted mean of its points) or
+    # "consistent" (the L2 projection M^-1 int psi v): `node_multipliers`
+    multiplier_mass: str = "lumped"
 
     @property
     def law_at_nodes(self):
@@ -94,6 +100,33 @@ class PairGeometry:
         W = np.bincount(idx, wp.ravel(), self.num_nodes)
         F = np.bincount(idx, (wp * np.asarray(point_values)[:, None]).ravel(), self.num_nodes)
         return F / np.maximum(W, 1e-300), W
+
+    def consistent_projection(self, point_values):
+        """Point values L2-projected on the P1 multiplier nodes, M^-1 int psi v, with M the
+        hats' consistent mass under the points' own quadrature (so a P1 field comes back
+        exactly); M is factorised once per pair (it is tridiagonal along each chain)."""
+        if getattr(self, "_mass_lu", None) is None:
+            import scipy.sparse as sp
+            import scipy.sparse.linalg as spl
+
+            ok = self.mult_nodes >= 0
+            psi = np.where(ok, self.mult_weights, 0.0)
+            nodes = np.maximum(self.mult_nodes, 0)
+            rows = np.repeat(nodes, 2, axis=1).ravel()  # (p, a, b) -> node a, node b
+            cols = np.tile(nodes, (1, 2)).ravel()
+            vals = (self.weights[:, None, None] * psi[:, :, None] * psi[:, None, :]).ravel()
+            n = self.num_nodes
+            self._mass_lu = spl.splu(sp.csc_matrix((vals, (rows, cols)), shape=(n, n)))
+        mean, W = self.project(point_values)
+        return self._mass_lu.solve(mean * W)
+
+    def node_multipliers(self, point_values):
+        """Uzawa's projection of point tractions on the multiplier nodes (traction "points"):
+        lumped, the fixed point has the weighted mean gap eps ((M_L - M) lambda)_i / W_i at a
+        node in contact; consistent, zero (and >= 0 at every node, see `contact_set`)."""
+        if self.multiplier_mass == "consistent":
+            return self.consistent_projection(point_values)
+        return self.project(point_values)[0]
 
     def to_points(self, law_values):
         """Values at the law points (multiplier nodes or points) at the points."""
@@ -480,6 +513,7 @@ def pair_geometry(
     multipliers=None,
     multiplier_length=None,
     traction="nodes",
+    multiplier_mass="lumped",
 ):
     """Contact quadrature of `pair` (indices into scene.bodies), or of body pair[0] and the
     rigid `obstacle` (pair[1] ignored): side j then has no dofs (nodes_j = 0).
@@ -495,13 +529,18 @@ def pair_geometry(
     traction (with multipliers): "nodes", the law acts on each node's weighted mean gap and the
     points carry the nodes' tractions interpolated; or "points", the law acts at each point
     and the nodes only carry the multipliers (`contact_set`: the augmented Lagrangian's
-    P1 multipliers with a point-wise traction).
+    P1 multipliers with a point-wise traction). multiplier_mass (traction "points"): "lumped"
+    or "consistent", Uzawa's projection on the nodes (`PairGeometry.node_multipliers`).
     Returns None when the pair cannot touch (disjoint inflated boxes or empty Gamma_c).
     """
     if projection not in ("auto", "levelset"):
         raise ValueError(f"projection must be 'auto' or 'levelset', got {projection!r}")
     if traction not in TRACTIONS:
         raise ValueError(f"traction must be one of {TRACTIONS}, got {traction!r}")
+    if multiplier_mass not in MULTIPLIER_MASSES:
+        raise ValueError(
+            f"multiplier_mass must be one of {MULTIPLIER_MASSES}, got {multiplier_mass!r}"
+        )
     i, j = pair
     bi = scene.bodies[i]
     bj = scene.bodies[j] if obstacle is None else obstacle
@@ -668,4 +707,5 @@ def pair_geometry(
         obstacle,
         *mult,
         traction,
+        multiplier_mass,
     )

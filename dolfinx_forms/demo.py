@@ -46,6 +46,7 @@ PROBLEM_OPTIONS = {
     "grid_refine": "grid_refine",
     "petsc": "petsc_options",
     "enforcement": "enforcement",
+    "multiplier_mass": "multiplier_mass",
     "linear_solver": "linear_solver",
 }
 

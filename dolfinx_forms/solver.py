@@ -24,7 +24,7 @@ from petsc4py import PETSc
 from .boundary import BodyForce, Dirichlet, Load, Traction, dirichlet_dofs  # noqa: F401
 from . import blas, linear
 from .bulk import BulkForms
-from .contact import TRACTIONS
+from .contact import MULTIPLIER_MASSES, TRACTIONS
 from .contact_set import STATE_NAMES, ContactSet  # noqa: F401
 from .laws import as_law
 from .newton import ContactSolverError, NewtonOptions, StepLog, load_steps  # noqa: F401
@@ -34,6 +34,13 @@ from .newton import ContactSolverError, NewtonOptions, StepLog, load_steps  # no
 # p(x) 1.35 / 0.94 / 0.91 / 1.26 % body-fitted and 1.85 / 1.21 / 1.19 / 1.62 % cut at
 # 0.5 / 1 / 2 / 5; stiffer approaches the over-constrained point-wise contact (3.5 % at 0.1)
 POINTWISE_EPS0 = 2.0
+# the same with multiplier_mass "consistent" (zero weighted mean gap at the fixed point), with
+# P1 nodes CONSISTENT_LENGTH h apart on both paths. Hertz at a/20, p(x) body-fitted / cut:
+# eps 1 h/E, nodes 1.5 h apart 1.16 / 1.53 %; nodes h apart 1.30 / 2.70 %; eps 2 h/E with the
+# lumped spacing (h / 1.5 h) 1.39 / 1.66 %; eps 0.5 h/E and below 1.5-3.6 / 2.0-8.3 %
+# (docs/demos.md)
+CONSISTENT_EPS0 = 1.0
+CONSISTENT_LENGTH = 1.5
 # eps_t = POINTWISE_EPS0_T h / E: Cattaneo-Mindlin (Q = 0.5 mu P, mu 0.1 and 1, a/20 and a/10,
 # both paths) gives the stick half-width off by -0.3 ... +1.5 % at 1.25, -0.05 ... +1.7 % at
 # 1.5 (a/20: +0.1 % body-fitted, +0.35 % cut) and +0.6 ... +2.0 % at 2 (the penalty: +0.06 ...
@@ -73,7 +80,10 @@ class ContactProblem:
     (the law at each point with the multipliers interpolated, `contact_set`; the kernel's eps_n
     and eps_t are then POINTWISE_EPS0 and POINTWISE_EPS0_T times h / E_mean, and eps0 relaxes
     the Uzawa step by min(1, eps_n / eps));
-    default "points" with "augmented".
+    default "points" with "augmented". multiplier_mass (augmented, P1, traction "points"):
+    "lumped" (default: the best p(x)) or "consistent" (zero weighted mean gap at every node in
+    contact, eps_n = CONSISTENT_EPS0 h / E and nodes CONSISTENT_LENGTH h apart by default;
+    `contact_set`).
     linear_solver: "auto", "condensed", "factorised" or "iterative" (`linear.py`: a linear bulk
     on one process is factorised once, with Newton on the Schur complement of the contact dofs;
     "iterative": CG + GAMG with the rigid-body modes, chosen by "auto" for large body-fitted
@@ -109,6 +119,7 @@ class ContactProblem:
         multipliers="default",
         multiplier_length=None,
         traction="default",
+        multiplier_mass="lumped",
         linear_solver="auto",
         log=print,
     ):
@@ -172,12 +183,28 @@ class ContactProblem:
             traction = "points" if enforcement == "augmented" else "nodes"
         if traction not in TRACTIONS:
             raise ValueError(f"traction must be one of {TRACTIONS}, got {traction!r}")
+        if multiplier_mass not in MULTIPLIER_MASSES:
+            raise ValueError(
+                f"multiplier_mass must be one of {MULTIPLIER_MASSES}, got {multiplier_mass!r}"
+            )
+        consistent = multiplier_mass == "consistent"
+        if consistent and not (
+            enforcement == "augmented" and multipliers == "P1" and traction == "points"
+        ):
+            raise ValueError(
+                "multiplier_mass 'consistent' needs enforcement 'augmented' with P1 multipliers "
+                f"and traction 'points', got {enforcement!r}, {multipliers!r}, {traction!r}"
+            )
         relaxation = 1.0
         if enforcement == "augmented" and multipliers is not None and traction == "points":
             # the point-wise regularisation is part of the discretisation; eps0 sets the step
-            fine = POINTWISE_EPS0 * h / E_mean
+            fine = (CONSISTENT_EPS0 if consistent else POINTWISE_EPS0) * h / E_mean
             relaxation = min(1.0, fine / self.eps_n)
             self.eps_n, self.eps_t = fine, POINTWISE_EPS0_T * h / E_mean
+        if multiplier_length is None:
+            multiplier_length = h * (
+                CONSISTENT_LENGTH if consistent else 1.5 if self.integration is not None else 1.0
+            )
         with self.phase("contact"):
             self.contact = ContactSet(
                 self.V,
@@ -192,14 +219,11 @@ class ContactProblem:
                 obstacles,
                 pair_grid_origin,
                 multipliers=multipliers,
-                multiplier_length=(
-                    h * (1.5 if self.integration is not None else 1.0)
-                    if multiplier_length is None
-                    else multiplier_length
-                ),
+                multiplier_length=multiplier_length,
                 enforcement=enforcement,
                 traction=traction,
                 relaxation=relaxation,
+                multiplier_mass=multiplier_mass,
             )
         self.pairs = self.contact.pairs
 

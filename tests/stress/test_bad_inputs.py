@@ -142,6 +142,8 @@ CASES = [
     # ------------------------------------------------ friction without its stage
     ("hertz", "--tangential 0.5 --mu 0", "--tangential"),
     ("hertz", "--mu 0.3", "--mu"),
+    ("patch_test", "--multiplier-mass consistent", "--multiplier-mass"),  # the penalty has none
+    ("hertz", "--multiplier-mass full --enforcement augmented", "--multiplier-mass"),
     # ------------------------------------------------ unknown options
     ("two_blocks", "--bogus-option 1", "--bogus-option"),
     ("contact_geometry", "--petsc ksp_type=cg", "--petsc"),  # no linear solver there
