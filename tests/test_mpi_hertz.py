@@ -5,7 +5,8 @@ The scene partitioner puts every cell of the contact search box on rank 0, so th
 points and both bodies' cells around them are local there; the other rank only assembles
 bulk elasticity. The reaction of the distributed problem must equal the serial one (each rank
 also solves the same problem on COMM_SELF) to 1e-8 relative, with the penalty and with the
-augmented Lagrangian (its loop's tests and Anderson's inner products reduced over the ranks).
+augmented Lagrangian (its loop's tests and Anderson's inner products reduced over the ranks),
+with its lumped and its consistent projection.
 """
 
 import numpy as np
@@ -19,6 +20,7 @@ from meshes.hertz import hertz_scene
 
 def reaction(comm, mu, disc="conforming", enforcement="penalty", band=0.13, box=None, **size):
     """box: the band the scene's contact box covers (None: the scene's default)."""
+    enforcement, _, mass = enforcement.partition("/")  # "augmented/consistent": its mass
     make = hertz_cut_scene if disc == "cut" else hertz_scene
     size = {**dict(R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.6), **size}
     scene = make(comm, **size, band=box)
@@ -33,6 +35,7 @@ def reaction(comm, mu, disc="conforming", enforcement="penalty", band=0.13, box=
         band=band,
         dirichlet=[Dirichlet("block_bottom", None, 0.0), top_x, top_y],
         enforcement=enforcement,
+        multiplier_mass=mass or "lumped",
         log=lambda *a: None,
     )
     p.solve(2)
@@ -56,6 +59,7 @@ def reaction(comm, mu, disc="conforming", enforcement="penalty", band=0.13, box=
         (0.3, "cut", "penalty"),
         (0.3, "conforming", "augmented"),
         (0.0, "cut", "augmented"),
+        (0.3, "cut", "augmented/consistent"),  # Uzawa's L2 projection, unclipped
     ],
 )
 def test_two_ranks_match_one(mu, disc, enforcement):
