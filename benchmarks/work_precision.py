@@ -3,14 +3,15 @@
 the time ratio to GetFEM's nodal P1 contact at equal p(x) error, both from one run.
 
 Runs demos/hertz.py as one subprocess per run (so the timings of the runs are independent)
-at contact mesh sizes h = a/10, a/14, a/20, a/28, a/40, a/56, a/80 (a: the Hertz half-width of
+at contact mesh sizes h = a/10, a/14, a/20, a/24, a/28, a/40, a/56, a/80 (a: the Hertz half-width of
 the demo defaults, ~1 mm; a/56 and a/80 so that both paths reach 0.5 %) for each
 discretization variant. Variants: the body-fitted (gmsh) path p1-tri, p2-tri, p1-quad, p2-quad
 (hertz.py [--degree 2] [--quads]) and the cut path q1-cut (hertz.py --discretization cut:
 level sets on a graded structured grid, Q1, hertz.py's default ghost penalty), each with the
 default penalty; p1-tri-al and q1-cut-al the same with --enforcement augmented (P1
-multipliers, point-wise traction). Default p1-tri,p1-quad,q1-cut,p1-tri-al,q1-cut-al, so one
-run compares both paths and both enforcements.
+multipliers, point-wise traction); q1-cut-al-z1 is q1-cut-al with the fine zone just covering
+the contact (--zone 1.0, see dolfinx_forms/study.py). Default p1-tri,p1-quad,q1-cut,p1-tri-al,
+q1-cut-al,q1-cut-al-z1, so one run compares both paths and both enforcements.
 
 GetFEM. When `import getfem` works (Debian's python3-getfem; `make bench` installs it) the same
 run also runs benchmarks/getfem_hertz.py (GetFEM's nodal P1 contact between the two bodies,
@@ -107,7 +108,7 @@ HERTZ_DEFAULTS = study.CASE  # passed explicitly to every run
 VARIANTS = study.VARIANTS  # name -> extra demo arguments
 ERRORS, PHASES = study.ERRORS, study.PHASES
 loglog_rate = study.loglog_rate
-DIVISORS = (10, 14, 20, 28, 40, 56, 80)
+DIVISORS = (10, 14, 20, 24, 28, 40, 56, 80)
 QUICK_DIVISORS = (10, 14, 20)
 GETFEM = ROOT / "benchmarks" / "getfem_hertz.py"
 GETFEM_VARIANT = "getfem-p1"  # GetFEM's runs in the tables and plots
@@ -121,7 +122,7 @@ REF_KEY = "pressure_rel_l2_error_ref"
 PROFILE_SAMPLES = 6001  # uniform points on [-1.5 a, 1.5 a] of the error against the reference
 BEST_TIE = 0.02  # GetFEM runs within 2 % of its smallest error are ties: the fastest is "best"
 # p2-tri is selectable (about 8 minutes alone); -al: augmented Lagrangian enforcement
-DEFAULT_VARIANTS = "p1-tri,p1-quad,q1-cut,p1-tri-al,q1-cut-al"
+DEFAULT_VARIANTS = "p1-tri,p1-quad,q1-cut,p1-tri-al,q1-cut-al,q1-cut-al-z1"
 QUICK_VARIANTS = "p1-tri,q1-cut"
 TARGET = 0.02  # pressure L2 error of the time-to-precision figure
 
@@ -572,6 +573,7 @@ COLORS = {
     "q1-cut": "tab:purple",
     "p1-tri-al": "tab:cyan",
     "q1-cut-al": "tab:pink",
+    "q1-cut-al-z1": "tab:olive",
     GETFEM_VARIANT: "k",
 }
 PHASE_COLORS = {

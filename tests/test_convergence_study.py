@@ -107,7 +107,14 @@ def test_work_precision_shares_the_runner():
     assert Path(wp.study.__file__).resolve() == Path(cs.__file__).resolve()
     assert wp.study.run_hertz.__code__.co_firstlineno == cs.run_hertz.__code__.co_firstlineno
     assert wp.VARIANTS["q1-cut"] == ["--discretization", "cut"]
-    assert wp.parse([]).variants == ["p1-tri", "p1-quad", "q1-cut", "p1-tri-al", "q1-cut-al"]
+    assert wp.parse([]).variants == [
+        "p1-tri",
+        "p1-quad",
+        "q1-cut",
+        "p1-tri-al",
+        "q1-cut-al",
+        "q1-cut-al-z1",
+    ]
     assert wp.VARIANTS["q1-cut-al"] == ["--discretization", "cut", "--enforcement", "augmented"]
     assert wp.parse(["--quick"]).variants == ["p1-tri", "q1-cut"]
     assert cs.loglog_rate([1, 2, 4], [1, 4, 16]) == pytest.approx(2.0)
