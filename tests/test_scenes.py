@@ -90,6 +90,24 @@ def test_patch_scene(tmp_path):
     assert m["checks_passed"]
 
 
+@pytest.mark.parametrize("mass", ["lumped", "consistent"])
+def test_patch_scene_augmented(tmp_path, mass):
+    """[solver] enforcement = "augmented": the exact pressure E' d / H, not the penalised one
+    (the patch reference then has eps_n = 0, so the scene's own checks hold as written)."""
+    out = tmp_path / mass
+    sets = ['solver.enforcement="augmented"', f'solver.multiplier_mass="{mass}"']
+    r = run("run", SCENES / "patch.toml", "--out", out, *[a for x in sets for a in ("--set", x)])
+    assert r.returncode == 0, r.stderr
+    m = metrics(out)
+    assert m["parameters"]["solver"]["enforcement"] == "augmented"
+    assert m["parameters"]["solver"]["multiplier_mass"] == mass
+    t = np.genfromtxt(out / "tractions.csv", delimiter=",", names=True, dtype=None, encoding=None)
+    exact = 0.01 / (1 - 0.3**2)
+    assert np.max(np.abs(t["p_n"] - exact)) <= 1e-8 * exact
+    assert m["results"]["reaction"][1] == pytest.approx(exact, rel=1e-8)
+    assert m["checks_passed"]
+
+
 def test_two_blocks_scene(tmp_path):
     """Tractions given as expressions in x, y, friction switched on before the ramp, a uniform
     grid of given cells: the stick zone of demos/two_blocks.py (checks in the scene)."""
@@ -175,6 +193,8 @@ def patch_dict():
         ),
         ("stages=[{kind='friction', mu=-1}]", "stages[0].mu: must be >= 0"),
         ("solver.steps=0", "solver.steps: must be >= 1"),
+        ("solver.enforcement='nitsche'", "solver.enforcement: must be one of"),
+        ("solver.multiplier_mass='consistent'", "solver.multiplier_mass: needs enforcement"),
         ("outputs.reaction='nope'", "outputs.reaction: unknown boundary 'nope'"),
         ("analytic.type='hertz'", "analytic.R: missing"),
         ("checks[0].quantity='foo.bar'", "checks[0].quantity: must be a metrics path"),
@@ -205,6 +225,13 @@ def test_description_defaults():
         "value": -0.01,
         "name": "top",
     }
+    assert spec["solver"]["enforcement"] == "penalty"
+    assert spec["solver"]["multiplier_mass"] == "lumped"
+    d = patch_dict()
+    del d["solver"]["eps0"]
+    assert load(d)["solver"]["eps0"] == 1.0
+    # augmented: eps0 sets only the loop's speed; the demos' fast default
+    assert load(d, ["solver.enforcement='augmented'"])["solver"]["eps0"] == 1e-2
     mindlin = load(SCENES / "mindlin.toml")  # extends hertz.toml
     assert mindlin["name"] == "mindlin" and mindlin["discretization"]["h"] == 0.05
     assert [s["kind"] for s in mindlin["stages"]] == ["force", "friction", "force"]
