@@ -51,6 +51,21 @@ POINTWISE_EPS0_T = 1.5
 BLAS_ONE_THREAD_DOFS = 50_000
 
 
+def contact_modulus(scene, laws, obstacles=()):
+    """The modulus the augmented Lagrangian's point-wise regularisation is scaled by: over the
+    pairs, the smallest harmonic mean 2 / (1/E_i + 1/E_j) of the two bodies' moduli (a rigid
+    obstacle: 2 E of its body), i.e. the most compliant contact. Equal moduli give E (what
+    POINTWISE_EPS0 was chosen with); the mean of all moduli instead made a soft disc between
+    stiff blocks (E 200 and 1e5: 66733) 330 times too stiff there, a checkerboard."""
+    E = {b.tag: laws[int(b.tag)].modulus for b in scene.bodies}
+    tags = [b.tag for b in scene.bodies]
+    pairs = [2.0 * E[tags[i]] * E[tags[j]] / (E[tags[i]] + E[tags[j]]) for i, j in scene.pairs]
+    for ob in obstacles:
+        held = [t for t in tags if ob.bodies is None or t in np.atleast_1d(ob.bodies)]
+        pairs += [2.0 * E[t] for t in held]
+    return min(pairs) if pairs else float(np.mean(list(E.values())))
+
+
 class ContactProblem:
     """Bodies of a `meshes.scene.Scene` in frictional contact (penalty, eqs 8-12, 48).
 
@@ -78,7 +93,7 @@ class ContactProblem:
     p(x) 1.9 / 2.3 / 3.1 % body-fitted at 0.75 / 1 / 1.5 h, 3.9 / 3.4 % cut at 1 / 1.5 h, with
     traction "nodes"). traction: "nodes" (the law on each node's weighted mean gap) or "points"
     (the law at each point with the multipliers interpolated, `contact_set`; the kernel's eps_n
-    and eps_t are then POINTWISE_EPS0 and POINTWISE_EPS0_T times h / E_mean, and eps0 relaxes
+    and eps_t are then POINTWISE_EPS0 and POINTWISE_EPS0_T times h / `contact_modulus`, and eps0 relaxes
     the Uzawa step by min(1, eps_n / eps));
     default "points" with "augmented". multiplier_mass (augmented, P1, traction "points"):
     "lumped" (default: the best p(x)) or "consistent" (zero weighted mean gap at every node in
@@ -198,9 +213,10 @@ class ContactProblem:
         relaxation = 1.0
         if enforcement == "augmented" and multipliers is not None and traction == "points":
             # the point-wise regularisation is part of the discretisation; eps0 sets the step
-            fine = (CONSISTENT_EPS0 if consistent else POINTWISE_EPS0) * h / E_mean
+            E_c = contact_modulus(scene, self.laws, obstacles)
+            fine = (CONSISTENT_EPS0 if consistent else POINTWISE_EPS0) * h / E_c
             relaxation = min(1.0, fine / self.eps_n)
-            self.eps_n, self.eps_t = fine, POINTWISE_EPS0_T * h / E_mean
+            self.eps_n, self.eps_t = fine, POINTWISE_EPS0_T * h / E_c
         if multiplier_length is None:
             multiplier_length = h * (
                 CONSISTENT_LENGTH if consistent else 1.5 if self.integration is not None else 1.0
