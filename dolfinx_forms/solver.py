@@ -93,8 +93,8 @@ class ContactProblem:
     p(x) 1.9 / 2.3 / 3.1 % body-fitted at 0.75 / 1 / 1.5 h, 3.9 / 3.4 % cut at 1 / 1.5 h, with
     traction "nodes"). traction: "nodes" (the law on each node's weighted mean gap) or "points"
     (the law at each point with the multipliers interpolated, `contact_set`; the kernel's eps_n
-    and eps_t are then POINTWISE_EPS0 and POINTWISE_EPS0_T times h / `contact_modulus`, and eps0 relaxes
-    the Uzawa step by min(1, eps_n / eps));
+    and eps_t are then POINTWISE_EPS0 and POINTWISE_EPS0_T times h / `contact_modulus`, and
+    eps0 relaxes the Uzawa step by min(1, eps_n / eps));
     default "points" with "augmented". multiplier_mass (augmented, P1, traction "points"):
     "lumped" (default: the best p(x)) or "consistent" (zero weighted mean gap at every node in
     contact, eps_n = CONSISTENT_EPS0 h / E and nodes CONSISTENT_LENGTH h apart by default;
