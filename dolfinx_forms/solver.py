@@ -203,6 +203,7 @@ class ContactProblem:
                 f"multiplier_mass must be one of {MULTIPLIER_MASSES}, got {multiplier_mass!r}"
             )
         consistent = multiplier_mass == "consistent"
+        self.multiplier_mass = multiplier_mass
         if consistent and not (
             enforcement == "augmented" and multipliers == "P1" and traction == "points"
         ):
@@ -407,6 +408,8 @@ def solver_metrics(problem, converged=True):
         "residual_history": [[float(r) for r in s.residuals] for s in problem.steps],
         "penalty": {"eps_n": problem.eps_n, "eps_t": problem.eps_t},
         "enforcement": problem.contact.enforcement,
+        # Uzawa's projection on the multipliers (`ContactProblem`): augmented only
+        "multiplier_mass": problem.multiplier_mass if problem.contact.augmented else None,
         "augmentations": [int(s.augmentations) for s in problem.steps],
         "cutbacks": int(sum(s.cutback for s in problem.steps)),
         "factorisations": int(problem.factorisations),

@@ -272,6 +272,7 @@ def test_consistent_mass_zero_weighted_gap(tmp_path, disc):
         assert abs(a - b) <= 1e-5 * abs(a), key
     for r in runs:
         assert r["parameters"]["multiplier_mass"] == "consistent"
+        assert r["solver"]["multiplier_mass"] == "consistent"
         assert r["solver"]["penetration_h"]["law_points"] < 1e-6
         assert r["solver"]["warnings"] == []
         # a coarser pressure than the lumped projection's at h = a/10: 2.15 % / 3.0-3.1 %
