@@ -94,6 +94,7 @@ class ContactSet:
             raise ValueError(f"relaxation must be in (0, 1], got {relaxation!r}")
         self.enforcement = enforcement
         self.relaxation = float(relaxation)
+        self.halvings = 0  # Uzawa steps halved where the active set cycled (`newton.al_stall`)
         self.eps_n, self.eps_t, self.mu = float(eps_n), float(eps_t), float(mu)
         self.pairs = []
         self.obstacles = list(obstacles)

@@ -218,6 +218,7 @@ def augmented_loop(problem, lam, residuals, depth=20):
         best, stalled = (change, 0) if change < (1 - 1e-3) * best else (best, stalled + 1)
         if stalled >= opts.al_stall:  # cycling: a shorter step, the mixing restarted
             rho, X, F, best, stalled = 0.5 * rho, [], [], change, 0
+            cs.halvings += 1
             problem.log(
                 f"augmented Lagrangian: no progress in {opts.al_stall} updates, step {rho:.3g}"
             )

@@ -411,6 +411,7 @@ def solver_metrics(problem, converged=True):
         # Uzawa's projection on the multipliers (`ContactProblem`): augmented only
         "multiplier_mass": problem.multiplier_mass if problem.contact.augmented else None,
         "augmentations": [int(s.augmentations) for s in problem.steps],
+        "uzawa_halvings": int(problem.contact.halvings),  # `NewtonOptions.al_stall`
         "cutbacks": int(sum(s.cutback for s in problem.steps)),
         "factorisations": int(problem.factorisations),
         "linear_solver": problem.linear.name,
