@@ -83,8 +83,12 @@ class DemoParser(argparse.ArgumentParser):
             opts = petsc_options(self, getattr(a, self._petsc_dest), defaults)
             setattr(a, self._petsc_dest, opts)
         given = sys.argv[1:] if args is None else args
-        if getattr(a, "multiplier_mass", "lumped") != "lumped" and a.enforcement != "augmented":
+        if getattr(a, "multiplier_mass", None) is not None and a.enforcement != "augmented":
             self.error("--multiplier-mass: needs --enforcement augmented (the penalty has none)")
+        if hasattr(a, "multiplier_mass") and a.enforcement == "augmented":
+            from .contact import DEFAULT_MULTIPLIER_MASS
+
+            a.multiplier_mass = a.multiplier_mass or DEFAULT_MULTIPLIER_MASS
         if (
             getattr(a, "enforcement", None) == "augmented"
             and hasattr(a, "eps0")
@@ -442,14 +446,18 @@ def add_enforcement(parser, choices=("penalty", "augmented")):
         ),
     )
     if "augmented" in choices:
+        from .contact import DEFAULT_MULTIPLIER_MASS, MULTIPLIER_MASSES
+
         parser.add_argument(
             "--multiplier-mass",
-            choices=["lumped", "consistent"],
-            default="lumped",
+            choices=list(MULTIPLIER_MASSES),
+            default=None,
             help=(
                 "--enforcement augmented: Uzawa's projection of the point tractions on the P1 "
-                "multipliers, lumped (the closer pressure) or consistent (zero weighted mean "
-                "gap at every node in contact, a coarser pressure) (default: lumped)"
+                "multipliers: hybrid (consistent on the nodes in contact, lumped at the edge: "
+                "zero weighted gap in contact, the lumped pressure's edge), consistent (zero "
+                "weighted mean gap at every node in contact, a coarser pressure) or lumped "
+                f"(weighted gaps ~1e-3 h) (default: {DEFAULT_MULTIPLIER_MASS})"
             ),
         )
 

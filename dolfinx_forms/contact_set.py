@@ -41,6 +41,15 @@ M^-1 int psi tau (`PairGeometry.consistent_projection`): a node in contact then 
 weighted mean gap and every other one a gap >= 0 (int_open psi (eps lambda_h + g)), at the price
 of a coarser pressure (Hertz a/20: 1.16 % / 1.53 %, 1.0-1.3 % body-fitted over loads 350-520);
 its multipliers are left unclipped (`admissible`).
+multiplier_mass "hybrid" (the default with "augmented") takes from each what it does well
+(`PairGeometry.hybrid_projection`): a node whose hat is mostly in contact (HYBRID_CLOSED_FRACTION
+of its weight on closed points) gets the consistent row, so int psi_i g >= 0 at the fixed point
+and = 0 where the hat is all in contact; the nodes at and past the contact edge keep the lumped
+row, which does not fit the square-root edge by an overshooting L2 fit. Tangential tractions
+are projected lumped (the lumped q(x)). Where the loop cycles (a row switching as points open
+and close) the rows are frozen (`freeze_rows`). Hertz a/20, loads 350-520: p(x) 0.78-1.09 %
+body-fitted, 1.12-1.50 % cut, every weighted gap < 1e-9 h (docs/demos.md).
+Its multipliers are left unclipped too.
 """
 
 import numpy as np
@@ -255,9 +264,10 @@ class ContactSet:
         n = sum(g.num_law_points for g in self.pairs)
         # with the consistent projection a fixed point has small tensile multipliers just past
         # the contact edge (the L2 fit of the pressure's edge; the law clips the traction):
-        # clipping them at the points stalls the loop, so its pairs are left as they are
+        # clipping them at the points stalls the loop, so its pairs are left as they are (the
+        # hybrid's consistent rows likewise)
         free = np.concatenate(
-            [np.full(g.num_law_points, g.multiplier_mass == "consistent") for g in self.pairs]
+            [np.full(g.num_law_points, g.multiplier_mass != "lumped") for g in self.pairs]
             or [np.zeros(0, bool)]
         )
         x = x.copy()
@@ -267,15 +277,28 @@ class ContactSet:
             x[n:] = np.where(free, x[n:], np.clip(x[n:], -bound, bound))
         return x
 
+    def freeze_rows(self, freeze=True):
+        """multiplier_mass "hybrid": keep (True) which nodes have consistent rows, as the last
+        projection chose them, or choose them afresh at every projection again (False). The
+        Uzawa loop freezes them where it cycles (`newton.augmented_loop`): a row that switches
+        as points open and close makes the update discontinuous, which can have no fixed
+        point; frozen, the projection is linear."""
+        for g in self.pairs:
+            if g.multiplier_mass == "hybrid":
+                g.frozen_rows = getattr(g, "hybrid_rows", None) if freeze else None
+
     def tractions(self):
         """The tractions of the last evaluation, laid out as `multipliers` (Uzawa's T); with
         traction "points" projected on the multiplier nodes and interpolated back."""
 
-        def law(g, tau):
-            return g.interpolate(g.node_multipliers(tau)) if g.law_at_points_with_nodes else tau
+        def law(g, s, key):
+            if not g.law_at_points_with_nodes:
+                return s[key]
+            closed = s["law_tau_n"] < 0 if key == "law_tau_n" else None  # hybrid: normal only
+            return g.interpolate(g.node_multipliers(s[key], closed))
 
         keys = ["law_tau_n"] + (["law_tau_t"] if self.mu > 0 else [])
-        parts = [law(g, s[key]) for key in keys for g, s in zip(self.pairs, self.last)]
+        parts = [law(g, s, key) for key in keys for g, s in zip(self.pairs, self.last)]
         return np.concatenate(parts) if parts else np.zeros(0)
 
     def assemble(self, u, b, A=None, fd=False, fd_step=1e-9, closed_gap=0.0, stick=False):

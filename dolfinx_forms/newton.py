@@ -191,6 +191,15 @@ def _dot(comm, a, b):
 
 
 def augmented_loop(problem, lam, residuals, depth=20):
+    """`_augmented_loop`; the hybrid projection's rows, frozen where it cycled, are free again
+    after it (the next load step chooses them afresh)."""
+    try:
+        return _augmented_loop(problem, lam, residuals, depth)
+    finally:
+        problem.contact.freeze_rows(False)
+
+
+def _augmented_loop(problem, lam, residuals, depth=20):
     """The augmented Lagrangian's outer loop at load level lam, after a converged Newton solve:
     the fixed point lambda = T(lambda), T(lambda) = the tractions of the solution with
     multipliers lambda (Uzawa's update, seed 003), accelerated by Anderson mixing of the last
@@ -219,6 +228,7 @@ def augmented_loop(problem, lam, residuals, depth=20):
         if stalled >= opts.al_stall:  # cycling: a shorter step, the mixing restarted
             rho, X, F, best, stalled = 0.5 * rho, [], [], change, 0
             cs.halvings += 1
+            cs.freeze_rows()  # the hybrid projection's rows stay as they are
             problem.log(
                 f"augmented Lagrangian: no progress in {opts.al_stall} updates, step {rho:.3g}"
             )

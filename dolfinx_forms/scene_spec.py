@@ -18,8 +18,8 @@ tan, exp, log, abs):
               [8 h], slope [0.25] (gmsh size growth per unit distance from `fine`),
               structured [false] (boxes without a window: transfinite grids of about h)
       both:   contact_box [the pairs' overlaps] (cells owned by MPI rank 0)
-  [solver]  enforcement ["penalty" | "augmented"], multiplier_mass ["lumped" | "consistent":
-      augmented only, see ContactProblem], eps0 [1.0; augmented 1e-2: the loop's speed only],
+  [solver]  enforcement ["penalty" | "augmented"], multiplier_mass ["hybrid" | "consistent" |
+      "lumped": augmented only, see ContactProblem], eps0 [1.0; augmented 1e-2: the loop's speed only],
       band [2 h], mu [0.0], ghost_penalty [0.01], grid_refine [4],
       num_gauss [2], steps [1], quadrature_degree, cut_degree [4], linear_solver ["auto"]
       ("condensed", "factorised", "iterative": dolfinx_forms/linear.py), petsc {KEY = VALUE},
@@ -291,8 +291,10 @@ def _solver(t):
     from .cli import AUGMENTED_EPS0
 
     enforcement = t.string("enforcement", "penalty", choices=["penalty", "augmented"])
-    mass = t.string("multiplier_mass", "lumped", choices=["lumped", "consistent"])
-    if mass != "lumped" and enforcement != "augmented":
+    from .contact import DEFAULT_MULTIPLIER_MASS, MULTIPLIER_MASSES
+
+    mass = t.string("multiplier_mass", None, choices=list(MULTIPLIER_MASSES))
+    if mass is not None and enforcement != "augmented":
         raise SpecError(
             t.path("multiplier_mass"), 'needs enforcement = "augmented" (the penalty has none)'
         )
@@ -300,7 +302,7 @@ def _solver(t):
     eps0 = 1.0 if enforcement == "penalty" else AUGMENTED_EPS0
     s = dict(
         enforcement=enforcement,
-        multiplier_mass=mass,
+        multiplier_mass=mass or (DEFAULT_MULTIPLIER_MASS if enforcement == "augmented" else None),
         eps0=t.number("eps0", eps0, lo=0, lo_open=True),
         band=t.number("band", None, lo=0, lo_open=True),
         mu=t.number("mu", 0.0, lo=0),

@@ -24,7 +24,7 @@ from petsc4py import PETSc
 from .boundary import BodyForce, Dirichlet, Load, Traction, dirichlet_dofs  # noqa: F401
 from . import blas, linear
 from .bulk import BulkForms
-from .contact import MULTIPLIER_MASSES, TRACTIONS
+from .contact import DEFAULT_MULTIPLIER_MASS, MULTIPLIER_MASSES, TRACTIONS
 from .contact_set import STATE_NAMES, ContactSet  # noqa: F401
 from .laws import as_law
 from .newton import ContactSolverError, NewtonOptions, StepLog, load_steps  # noqa: F401
@@ -38,7 +38,9 @@ POINTWISE_EPS0 = 2.0
 # P1 nodes CONSISTENT_LENGTH h apart on both paths. Hertz at a/20, p(x) body-fitted / cut:
 # eps 1 h/E, nodes 1.5 h apart 1.16 / 1.53 %; nodes h apart 1.30 / 2.70 %; eps 2 h/E with the
 # lumped spacing (h / 1.5 h) 1.39 / 1.66 %; eps 0.5 h/E and below 1.5-3.6 / 2.0-8.3 %
-# (docs/demos.md)
+# (docs/demos.md). "hybrid" likewise: at a/20 eps 1 / 1.5 / 2 h/E with nodes 1.5 h apart gave
+# 0.93 / 0.97 / 1.08 % body-fitted and 1.31 / 1.24 / 1.27 % cut (fully closed rows only; h
+# apart 1.06 / 1.85 %)
 CONSISTENT_EPS0 = 1.0
 CONSISTENT_LENGTH = 1.5
 # eps_t = POINTWISE_EPS0_T h / E: Cattaneo-Mindlin (Q = 0.5 mu P, mu 0.1 and 1, a/20 and a/10,
@@ -96,9 +98,11 @@ class ContactProblem:
     and eps_t are then POINTWISE_EPS0 and POINTWISE_EPS0_T times h / `contact_modulus`, and
     eps0 relaxes the Uzawa step by min(1, eps_n / eps));
     default "points" with "augmented". multiplier_mass (augmented, P1, traction "points"):
-    "lumped" (default: the best p(x)) or "consistent" (zero weighted mean gap at every node in
-    contact, eps_n = CONSISTENT_EPS0 h / E and nodes CONSISTENT_LENGTH h apart by default;
-    `contact_set`).
+    "hybrid" (default: zero weighted gap on the closed part of every node mostly in contact,
+    the lumped projection at the contact edge), "consistent" (zero weighted mean gap at every
+    node in contact, a coarser pressure) or "lumped" (weighted gaps ~1e-3 h); the first two
+    with eps_n = CONSISTENT_EPS0 h / E and nodes CONSISTENT_LENGTH h apart by default
+    (`contact_set`).
     linear_solver: "auto", "condensed", "factorised" or "iterative" (`linear.py`: a linear bulk
     on one process is factorised once, with Newton on the Schur complement of the contact dofs;
     "iterative": CG + GAMG with the rigid-body modes, chosen by "auto" for large body-fitted
@@ -134,7 +138,7 @@ class ContactProblem:
         multipliers="default",
         multiplier_length=None,
         traction="default",
-        multiplier_mass="lumped",
+        multiplier_mass=None,
         linear_solver="auto",
         log=print,
     ):
@@ -198,18 +202,20 @@ class ContactProblem:
             traction = "points" if enforcement == "augmented" else "nodes"
         if traction not in TRACTIONS:
             raise ValueError(f"traction must be one of {TRACTIONS}, got {traction!r}")
+        projected = enforcement == "augmented" and multipliers == "P1" and traction == "points"
+        if multiplier_mass is None:  # the default where Uzawa projects on P1 nodes
+            multiplier_mass = DEFAULT_MULTIPLIER_MASS if projected else "lumped"
         if multiplier_mass not in MULTIPLIER_MASSES:
             raise ValueError(
                 f"multiplier_mass must be one of {MULTIPLIER_MASSES}, got {multiplier_mass!r}"
             )
-        consistent = multiplier_mass == "consistent"
+        consistent = multiplier_mass != "lumped"  # "consistent" or "hybrid"
         self.multiplier_mass = multiplier_mass
-        if consistent and not (
-            enforcement == "augmented" and multipliers == "P1" and traction == "points"
-        ):
+        if consistent and not projected:
             raise ValueError(
-                "multiplier_mass 'consistent' needs enforcement 'augmented' with P1 multipliers "
-                f"and traction 'points', got {enforcement!r}, {multipliers!r}, {traction!r}"
+                f"multiplier_mass {multiplier_mass!r} needs enforcement 'augmented' with P1 "
+                f"multipliers and traction 'points', got {enforcement!r}, {multipliers!r}, "
+                f"{traction!r}"
             )
         relaxation = 1.0
         if enforcement == "augmented" and multipliers is not None and traction == "points":

@@ -90,7 +90,7 @@ def test_patch_scene(tmp_path):
     assert m["checks_passed"]
 
 
-@pytest.mark.parametrize("mass", ["lumped", "consistent"])
+@pytest.mark.parametrize("mass", ["lumped", "consistent", "hybrid"])
 def test_patch_scene_augmented(tmp_path, mass):
     """[solver] enforcement = "augmented": the exact pressure E' d / H, not the penalised one
     (the patch reference then has eps_n = 0, so the scene's own checks hold as written)."""
@@ -128,7 +128,9 @@ def test_soft_disc_between_stiff_blocks_augmented(tmp_path, h):
     assert m["solver"]["cutbacks"] == 0
     if h == 0.005:  # the full steps cycle there: halved (2-4 times seen)
         assert m["solver"]["uzawa_halvings"] > 0
-    assert m["solver"]["penalty"]["eps_n"] == pytest.approx(2.0 * h / (2 * 200 * 1e5 / (1e5 + 200)))
+    # the default hybrid projection's eps_n = CONSISTENT_EPS0 h / E_c
+    assert m["solver"]["multiplier_mass"] == "hybrid"
+    assert m["solver"]["penalty"]["eps_n"] == pytest.approx(1.0 * h / (2 * 200 * 1e5 / (1e5 + 200)))
 
 
 def test_contact_modulus():
@@ -264,7 +266,10 @@ def test_description_defaults():
         "name": "top",
     }
     assert spec["solver"]["enforcement"] == "penalty"
-    assert spec["solver"]["multiplier_mass"] == "lumped"
+    assert spec["solver"]["multiplier_mass"] is None  # the penalty projects nothing
+    d = patch_dict()
+    d["solver"]["enforcement"] = "augmented"
+    assert load(d)["solver"]["multiplier_mass"] == "hybrid"
     d = patch_dict()
     del d["solver"]["eps0"]
     assert load(d)["solver"]["eps0"] == 1.0
