@@ -9,7 +9,7 @@ discretization variant. Variants: the body-fitted (gmsh) path p1-tri, p2-tri, p1
 (hertz.py [--degree 2] [--quads]) and the cut path q1-cut (hertz.py --discretization cut:
 level sets on a graded structured grid, Q1, hertz.py's default ghost penalty), each with the
 default penalty; p1-tri-al and q1-cut-al the same with --enforcement augmented (P1
-multipliers, point-wise traction); q1-cut-al-z1 is q1-cut-al with the fine zone just covering
+multipliers, point-wise traction, --multiplier-mass lumped: the closest pressure); q1-cut-al-z1 is q1-cut-al with the fine zone just covering
 the contact (--zone 1.0, see dolfinx_forms/study.py). Default p1-tri,p1-quad,q1-cut,p1-tri-al,
 q1-cut-al,q1-cut-al-z1, so one run compares both paths and both enforcements.
 

@@ -86,12 +86,13 @@ def test_demo_reports_soft_penalty(tmp_path):
 
 
 def test_demo_reports_under_resolved_multipliers(tmp_path):
-    """Augmented at h = a/2: 6 multiplier nodes carry the Hertz pressure (body-fitted), the P1
-    multipliers widen the zone (a +9.2 % against the penalty's +2.7 %): flagged. At a/10 (20
-    nodes) quiet (test_demo_reports_stiff_penalty)."""
+    """Augmented at h = a/2: 4 multiplier nodes carry the Hertz pressure (body-fitted, the
+    default hybrid projection's nodes 1.5 h apart; 6 with the lumped one's h), the P1
+    multipliers widen the zone (lumped: a +9.2 % against the penalty's +2.7 %): flagged. At
+    a/10 (20 nodes) quiet (test_demo_reports_stiff_penalty)."""
     m, r = hertz(tmp_path / "coarse", "--h", "0.5", "--enforcement", "augmented")
     (w,) = [w for w in m["solver"]["warnings"] if "multiplier nodes carry" in w]
-    assert "only 6 multiplier nodes" in w
+    assert "only 4 multiplier nodes" in w
     assert f"WARNING: {w}" in r.stdout
 
 
