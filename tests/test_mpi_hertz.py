@@ -6,7 +6,7 @@ points and both bodies' cells around them are local there; the other rank only a
 bulk elasticity. The reaction of the distributed problem must equal the serial one (each rank
 also solves the same problem on COMM_SELF) to 1e-8 relative, with the penalty and with the
 augmented Lagrangian (its loop's tests and Anderson's inner products reduced over the ranks),
-with its lumped and its consistent projection.
+with its lumped, consistent and hybrid (the default) projections.
 """
 
 import numpy as np
@@ -20,7 +20,8 @@ from meshes.hertz import hertz_scene
 
 def reaction(comm, mu, disc="conforming", enforcement="penalty", band=0.13, box=None, **size):
     """box: the band the scene's contact box covers (None: the scene's default)."""
-    enforcement, _, mass = enforcement.partition("/")  # "augmented/consistent": its mass
+    # "augmented/consistent": its mass ("augmented": the lumped one, "augmented/hybrid" the default)
+    enforcement, _, mass = enforcement.partition("/")
     make = hertz_cut_scene if disc == "cut" else hertz_scene
     size = {**dict(R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.6), **size}
     scene = make(comm, **size, band=box)
@@ -60,6 +61,8 @@ def reaction(comm, mu, disc="conforming", enforcement="penalty", band=0.13, box=
         (0.3, "conforming", "augmented"),
         (0.0, "cut", "augmented"),
         (0.3, "cut", "augmented/consistent"),  # Uzawa's L2 projection, unclipped
+        (0.3, "conforming", "augmented/hybrid"),  # consistent rows in contact, lumped at the edge
+        (0.0, "cut", "augmented/hybrid"),
     ],
 )
 def test_two_ranks_match_one(mu, disc, enforcement):
