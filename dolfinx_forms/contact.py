@@ -272,7 +272,7 @@ def split_segments(pieces, cells, piece, t, tol):
     return np.stack([x0, x1], axis=1), cells[k].astype(np.int32)
 
 
-def label_breaks(pieces, labels, tol, iterations=36):
+def label_breaks(pieces, labels, tol, iterations=36, label=None):
     """Where the integer labels of the points of the (m, 2, 2) `pieces` change along them
     (`labels(points)` -> (n, k), e.g. the cells that hold the closest points on each body):
     for each label that differs between a piece's ends, its first change, by bisection to
@@ -280,16 +280,22 @@ def label_breaks(pieces, labels, tol, iterations=36):
     tol = 1e-10 dx). Labels are read tol (a length, at least `split_segments`' shortest piece;
     above the closest points' own error, or that error reads as a change at every cut made)
     inside the ends, so a change closer to an end is ignored. One change per label and round:
-    call it again on the split pieces for more. Returns (piece, t) pairs for
-    `split_segments`."""
+    call it again on the split pieces for more. label(points, col) -> (n,): the label col[i]
+    of points[i] alone (default: labels(points) read there), for a bisection that reads one
+    label per point. Returns (piece, t) pairs for `split_segments`."""
     a, b = pieces[:, 0], pieces[:, 1]
     inset = np.minimum(tol / np.maximum(np.linalg.norm(b - a, axis=1), 1e-300), 0.25)[:, None]
     la, lb = labels(a + inset * (b - a)), labels(b - inset * (b - a))
     k, col = np.nonzero(la != lb)  # one bisection per (piece, label) that changes
     lo, hi = inset[k, 0], 1.0 - inset[k, 0]
+    if label is None:
+
+        def label(points, col):
+            return labels(points)[np.arange(len(points)), col]
+
     for _ in range(iterations):
         mid = 0.5 * (lo + hi)
-        same = labels(a[k] + mid[:, None] * (b[k] - a[k]))[np.arange(len(k)), col] == la[k, col]
+        same = label(a[k] + mid[:, None] * (b[k] - a[k]), col) == la[k, col]
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
     return k, 0.5 * (lo + hi)
 
@@ -668,19 +674,42 @@ def pair_geometry(
 
         phi_int = _cpp.intermediate_levelset(phi_i, phi_j)
 
+        def cell_label(side, points, proj):
+            loc = locators[side]
+            return (
+                np.zeros(len(points), np.int32)
+                if loc is None
+                else loc.cell_label(proj, max_outside)
+            )
+
+        def past_both(points, proj):
+            n = np.asarray(phi_int.evaluate(points)[1])
+            n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+            return beyond_end(points, proj[0], n, 1e-9 * dx) & beyond_end(
+                points, proj[1], n, 1e-9 * dx
+            )
+
         def labels(points):
             """Per body the cell that holds the closest point; whether the point lies past the
             ends of both bodies (`beyond_end`)."""
-            n = np.asarray(phi_int.evaluate(points)[1])
-            n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
             # exact shapes' gradients by differences of 1e-7 scale: fine enough near corners
             proj = [pr["points"] for pr in project(points, 1e-3 * h)]
-            cells = [
-                np.zeros(len(points), np.int32) if loc is None else loc.cell_label(p, max_outside)
-                for loc, p in zip(locators, proj)
-            ]
-            past = [beyond_end(points, p, n, 1e-9 * dx) for p in proj]
-            return np.stack(cells + [past[0] & past[1]], axis=1)
+            cells = [cell_label(side, points, p) for side, p in enumerate(proj)]
+            return np.stack(cells + [past_both(points, proj)], axis=1)
+
+        def label(points, col):
+            """labels(points)[i, col[i]]: a cell label needs one body's closest point only."""
+            out = np.empty(len(points), np.int64)
+            for c in np.unique(col):
+                at = np.flatnonzero(col == c)
+                if c == 2:
+                    proj = [pr["points"] for pr in project(points[at], 1e-3 * h)]
+                    out[at] = past_both(points[at], proj)
+                else:
+                    b, phi = ((bi, phi_i), (bj, phi_j))[c]
+                    p = closest_points(b, phi, points[at], 1e-3 * h, exact=projection == "auto")
+                    out[at] = cell_label(c, points[at], p["points"])
+            return out
 
         # a piece (h / grid_refine) rarely holds more than one change; after the first round
         # only the sub-pieces of the pieces just split can hold one (the others had none).
@@ -691,7 +720,7 @@ def pair_geometry(
         # that close to an end costs O((1e-3 dx / h)^2) of that piece's integral.
         check, inset = np.ones(len(segs), bool), 100 * tol
         for _ in range(6):
-            piece, t = label_breaks(segs[check], labels, inset)
+            piece, t = label_breaks(segs[check], labels, inset, label=label)
             inset = 1e-3 * dx
             if len(piece) == 0:
                 break
