@@ -75,6 +75,10 @@ class PairGeometry:
     # with traction "points": "lumped" (each node the hat-weighted mean of its points),
     # "consistent" (the L2 projection M^-1 int psi v) or "hybrid": `node_multipliers`
     multiplier_mass: str = "lumped"
+    # "hybrid": the nodes whose rows the last projection made consistent, and the rows kept
+    # (not chosen afresh) while set: `hybrid_projection`, `contact_set.ContactSet.freeze_rows`
+    hybrid_rows: np.ndarray = None
+    frozen_rows: np.ndarray = None
 
     @property
     def law_at_nodes(self):
@@ -143,7 +147,7 @@ class PairGeometry:
         psi = np.where(self.mult_nodes >= 0, self.mult_weights, 0.0)
         nodes = np.maximum(self.mult_nodes, 0)
         mean, W = self.project(point_values)
-        rows_c = getattr(self, "frozen_rows", None)
+        rows_c = self.frozen_rows
         if rows_c is None:
             Wc = np.bincount(
                 nodes.ravel(), ((self.weights * closed)[:, None] * psi).ravel(), self.num_nodes
@@ -165,8 +169,9 @@ class PairGeometry:
         """Uzawa's projection of point tractions on the multiplier nodes (traction "points"):
         lumped, the fixed point has the weighted mean gap eps ((M_L - M) lambda)_i / W_i at a
         node in contact; consistent, zero (and >= 0 at every node, see `contact_set`); hybrid
-        (`hybrid_projection`, closed: the closed points, bool), zero on the closed part of a
-        node mostly in contact. Hybrid projects tangential tractions (closed None) lumped."""
+        (`hybrid_projection`, closed: the closed points, bool), >= 0 at a node mostly in
+        contact and zero when its hat is all in contact. Hybrid projects tangential tractions
+        (closed None) lumped."""
         if self.multiplier_mass == "consistent":
             return self.consistent_projection(point_values)
         if self.multiplier_mass == "hybrid" and closed is not None:

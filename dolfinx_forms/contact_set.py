@@ -285,7 +285,7 @@ class ContactSet:
         point; frozen, the projection is linear."""
         for g in self.pairs:
             if g.multiplier_mass == "hybrid":
-                g.frozen_rows = getattr(g, "hybrid_rows", None) if freeze else None
+                g.frozen_rows = g.hybrid_rows if freeze else None
 
     def tractions(self):
         """The tractions of the last evaluation, laid out as `multipliers` (Uzawa's T); with
