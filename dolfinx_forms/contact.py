@@ -112,24 +112,24 @@ class PairGeometry:
         F = np.bincount(idx, (wp * np.asarray(point_values)[:, None]).ravel(), self.num_nodes)
         return F / np.maximum(W, 1e-300), W
 
+    def _mass_entries(self):
+        """The hats' consistent mass under the points' own quadrature as (rows, cols, values):
+        int psi_a psi_b summed point by point."""
+        psi = np.where(self.mult_nodes >= 0, self.mult_weights, 0.0)
+        nodes = np.maximum(self.mult_nodes, 0)
+        rows = np.repeat(nodes, 2, axis=1).ravel()  # (p, a, b) -> node a, node b
+        cols = np.tile(nodes, (1, 2)).ravel()
+        vals = (self.weights[:, None, None] * psi[:, :, None] * psi[:, None, :]).ravel()
+        return rows, cols, vals
+
     def consistent_projection(self, point_values):
         """Point values L2-projected on the P1 multiplier nodes, M^-1 int psi v, with M the
         hats' consistent mass under the points' own quadrature (so a P1 field comes back
-        exactly); M is factorised once per pair (it is tridiagonal along each chain)."""
+        exactly); M is factorised once per pair (`mass_solver`)."""
         if getattr(self, "_mass_lu", None) is None:
-            import scipy.sparse as sp
-            import scipy.sparse.linalg as spl
-
-            ok = self.mult_nodes >= 0
-            psi = np.where(ok, self.mult_weights, 0.0)
-            nodes = np.maximum(self.mult_nodes, 0)
-            rows = np.repeat(nodes, 2, axis=1).ravel()  # (p, a, b) -> node a, node b
-            cols = np.tile(nodes, (1, 2)).ravel()
-            vals = (self.weights[:, None, None] * psi[:, :, None] * psi[:, None, :]).ravel()
-            n = self.num_nodes
-            self._mass_lu = spl.splu(sp.csc_matrix((vals, (rows, cols)), shape=(n, n)))
+            self._mass_lu = mass_solver(*self._mass_entries(), np.zeros(self.num_nodes))
         mean, W = self.project(point_values)
-        return self._mass_lu.solve(mean * W)
+        return self._mass_lu(mean * W)
 
     def hybrid_projection(self, point_values, closed):
         """Point values projected on the P1 multiplier nodes with one row per node: a node
@@ -141,9 +141,6 @@ class PairGeometry:
         the pressure's square-root edge, so no overshoot there. `frozen_rows` (set by
         `contact_set.ContactSet.freeze_rows`) fixes which rows are consistent: the projection
         is then linear, as the other two."""
-        import scipy.sparse as sp
-        import scipy.sparse.linalg as spl
-
         psi = np.where(self.mult_nodes >= 0, self.mult_weights, 0.0)
         nodes = np.maximum(self.mult_nodes, 0)
         mean, W = self.project(point_values)
@@ -156,14 +153,12 @@ class PairGeometry:
         self.hybrid_rows = rows_c
         key = rows_c.tobytes()
         if getattr(self, "_hybrid_key", None) != key:  # refactorised when the rows change
-            rows = np.repeat(nodes, 2, axis=1).ravel()  # (p, a, b) -> node a, node b
-            cols = np.tile(nodes, (1, 2)).ravel()
-            vals = (self.weights[:, None, None] * psi[:, :, None] * psi[:, None, :]).ravel()
+            rows, cols, vals = self._mass_entries()
             keep = rows_c[rows]
-            M = sp.csc_matrix((vals[keep], (rows[keep], cols[keep])), shape=(len(W),) * 2)
-            M = M + sp.diags(np.where(rows_c, 0.0, np.where(W > 0, W, 1.0)))
-            self._hybrid_key, self._hybrid_lu = key, spl.splu(M.tocsc())
-        return self._hybrid_lu.solve(mean * W)
+            lumped = np.where(rows_c, 0.0, np.where(W > 0, W, 1.0))
+            solve = mass_solver(rows[keep], cols[keep], vals[keep], lumped)
+            self._hybrid_key, self._hybrid_lu = key, solve
+        return self._hybrid_lu(mean * W)
 
     def node_multipliers(self, point_values, closed=None):
         """Uzawa's projection of point tractions on the multiplier nodes (traction "points"):
@@ -181,6 +176,29 @@ class PairGeometry:
     def to_points(self, law_values):
         """Values at the law points (multiplier nodes or points) at the points."""
         return self.interpolate(law_values) if self.law_at_nodes else law_values
+
+
+# multiplier nodes of a pair up to which its mass matrix is inverted densely by numpy (1000:
+# ~50 ms once per pair); above, scipy's sparse LU, whose import costs 0.14 s here: more than the
+# whole augmented loop of a cut Hertz run
+DENSE_MASS_NODES = 1000
+
+
+def mass_solver(rows, cols, vals, diag):
+    """b -> A^-1 b for the n x n matrix A = sum of vals at (rows, cols) + diag(diag), n =
+    len(diag): a mass matrix of P1 multiplier hats (tridiagonal along each chain, some rows
+    lumped)."""
+    n = len(diag)
+    if n <= DENSE_MASS_NODES:
+        A = np.bincount(rows * n + cols, vals, n * n).astype(float).reshape(n, n)
+        A[np.diag_indices(n)] += diag
+        inv = np.linalg.inv(A)
+        return lambda b: inv @ b
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spl
+
+    lu = spl.splu((sp.csc_matrix((vals, (rows, cols)), shape=(n, n)) + sp.diags(diag)).tocsc())
+    return lu.solve
 
 
 def surface_chains(pieces, tol):

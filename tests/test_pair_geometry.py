@@ -207,3 +207,29 @@ def test_point_wise_traction_keeps_the_points_as_law_points(hertz):
     np.testing.assert_array_equal(gp.to_points(x), x)
     with pytest.raises(ValueError, match="traction"):
         pair_geometry(V, scene, (0, 1), 0.2, multipliers="P1", traction="both")
+
+
+def test_mass_solver_dense_and_sparse(monkeypatch):
+    """contact.mass_solver: numpy's dense inverse (small pairs: no scipy import) and scipy's
+    sparse LU (above DENSE_MASS_NODES) solve the same hat mass matrix, repeated entries summed
+    and a diagonal added (the hybrid projection's lumped rows)."""
+    from dolfinx_forms import contact
+
+    rng = np.random.default_rng(3)
+    n = 40
+    a = np.arange(n - 1)
+    rows = np.concatenate([a, a + 1, a, a + 1])  # per element: its 2 x 2 block
+    cols = np.concatenate([a, a + 1, a + 1, a])
+    w = rng.uniform(0.5, 1.5, n - 1)
+    vals = np.concatenate([w / 3, w / 3, w / 6, w / 6])
+    diag = np.where(np.arange(n) % 7 == 0, 1.0, 0.0)
+    A = np.zeros((n, n))
+    np.add.at(A, (rows, cols), vals)
+    A += np.diag(diag)
+    b = rng.normal(size=n)
+    x = np.linalg.solve(A, b)
+    dense = contact.mass_solver(rows, cols, vals, diag)(b)
+    monkeypatch.setattr(contact, "DENSE_MASS_NODES", 0)
+    sparse = contact.mass_solver(rows, cols, vals, diag)(b)
+    assert np.allclose(dense, x, rtol=0, atol=1e-12 * np.abs(x).max())
+    assert np.allclose(sparse, x, rtol=0, atol=1e-12 * np.abs(x).max())
