@@ -19,8 +19,8 @@ tan, exp, log, abs):
               structured [false] (boxes without a window: transfinite grids of about h)
       both:   contact_box [the pairs' overlaps] (cells owned by MPI rank 0)
   [solver]  enforcement ["penalty" | "augmented"], multiplier_mass ["hybrid" | "consistent" |
-      "lumped": augmented only, see ContactProblem], eps0 [1.0; augmented 1e-2: the loop's speed only],
-      band [2 h], mu [0.0], ghost_penalty [0.01], grid_refine [4],
+      "lumped": augmented only, see ContactProblem], eps0 [1.0; augmented 1e-2: the loop's
+      speed only], band [2 h], mu [0.0], ghost_penalty [0.01], grid_refine [4],
       num_gauss [2], steps [1], quadrature_degree, cut_degree [4], linear_solver ["auto"]
       ("condensed", "factorised", "iterative": dolfinx_forms/linear.py), petsc {KEY = VALUE},
       newton {rtol, ftol, atol, stol, max_iterations, max_cutbacks}
