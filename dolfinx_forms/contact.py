@@ -678,11 +678,12 @@ def pair_geometry(
         for body in (bi, bj)
     ]
 
+    def project_on(side, points, scale=h):
+        b, phi = ((bi, phi_i), (bj, phi_j))[side]
+        return closest_points(b, phi, points, scale, exact=projection == "auto")
+
     def project(points, scale=h):
-        return [
-            closest_points(b, phi, points, scale, exact=projection == "auto")
-            for b, phi in ((bi, phi_i), (bj, phi_j))
-        ]
+        return [project_on(side, points, scale) for side in (0, 1)]
 
     mult = (None, None)
     if multipliers is not None:
@@ -729,9 +730,8 @@ def pair_geometry(
                     proj = [pr["points"] for pr in project(points[at], 1e-3 * h)]
                     out[at] = past_both(points[at], proj)
                 else:
-                    b, phi = ((bi, phi_i), (bj, phi_j))[c]
-                    p = closest_points(b, phi, points[at], 1e-3 * h, exact=projection == "auto")
-                    out[at] = cell_label(c, points[at], p["points"])
+                    p = project_on(c, points[at], 1e-3 * h)["points"]
+                    out[at] = cell_label(c, points[at], p)
             return out
 
         # a piece (h / grid_refine) rarely holds more than one change; after the first round

@@ -116,14 +116,9 @@ def test_work_precision_shares_the_runner():
         "q1-cut-al-z1",
     ]
     # the augmented variants with the projection they were measured with (the closest p(x))
-    assert wp.VARIANTS["q1-cut-al"] == [
-        "--discretization",
-        "cut",
-        "--enforcement",
-        "augmented",
-        "--multiplier-mass",
-        "lumped",
-    ]
+    al = wp.VARIANTS["q1-cut-al"]
+    assert al[:4] == ["--discretization", "cut", "--enforcement", "augmented"]
+    assert al[4:] == ["--multiplier-mass", "lumped"]
     assert wp.parse(["--quick"]).variants == ["p1-tri", "q1-cut"]
     assert cs.loglog_rate([1, 2, 4], [1, 4, 16]) == pytest.approx(2.0)
     assert cs.loglog_rate([1, 1], [1, 2]) is None
