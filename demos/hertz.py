@@ -24,7 +24,7 @@ from dolfinx_forms.demo import run_case
 from dolfinx_forms.protocol import friction_on, reach_force
 from dolfinx_forms.solver import Dirichlet
 from meshes.cut import hertz_cut_scene
-from meshes.hertz import hertz_scene, mesh_size_bounds
+from meshes.hertz import MESHERS, hertz_scene, mesh_size_bounds
 
 PROTOCOL = (
     "rigid approach of the cylinder top, frictionless, iterated to the load P; "
@@ -54,6 +54,9 @@ OPTIONS = [  # option, kind, default[, help]
     ("--grid-refine", range(1, 17), 4, "level-set grid cells per contact mesh size h"),
     ("--gauss", range(1, 6), 2, "Gauss points per contact-surface segment"),
     ("--quads", bool, False, "quadrilateral cells"),
+    ("--mesher", list(MESHERS), "gmsh",
+     "body-fitted mesher: gmsh, or layers (triangles in layers around the contact point, "
+     "no gmsh)"),
     ("--steps", range(1, 101), 1, "load steps of the first normal approach"),
     ("--tangential-steps", range(2, 101), 12, "maximum displacement steps of the tangential stage"),
 ]
@@ -67,6 +70,8 @@ def parse(argv):
         p.error("--tangential: a Cattaneo-Mindlin stage needs --mu > 0")
     if a.mu > 0 and a.tangential == 0:
         p.error("--mu: friction acts in the tangential stage only: give --tangential r > 0")
+    if a.mesher != "gmsh" and (a.discretization == "cut" or a.quads):
+        p.error(f"--mesher {a.mesher}: body-fitted triangles only (not with --quads or cut)")
     if a.grading is not None and a.discretization == "cut" and not a.grading > 1:
         p.error(f"--grading: the cut grid's growth ratio must be > 1, got {a.grading:g}")
     # the defaults that depend on the Hertz half-width, then what the scene can mesh
@@ -112,7 +117,7 @@ def scene(run):
     size["growth"] = p["grading"] or (2.0 if cut else 0.25)
     if cut:  # graded grid, spacing h on the zone; cylinder cut
         return hertz_cut_scene(run.comm, **size)
-    return hertz_scene(run.comm, **size, quads=p["quads"])
+    return hertz_scene(run.comm, **size, quads=p["quads"], mesher=p["mesher"])
 
 
 def problem(run):

@@ -27,9 +27,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from .scene import Body, Scene, extract_gmsh, gmsh_model, max_edge_in_box, scene_from_gmsh, summary
+from .scene import (
+    Body,
+    Scene,
+    extract_gmsh,
+    gmsh_model,
+    max_edge_in_box,
+    scene_from_arrays,
+    scene_from_gmsh,
+    summary,
+)
 
 GROWTH = 0.25  # mesh size slope outside the zone
+MESHERS = ("gmsh", "layers")
 
 
 def hertz_contact_box(R=10.0, width=40.0, depth=20.0, zone=1.5, Ry=None, band=None, h=None):
@@ -181,6 +191,40 @@ def _build(gmsh, R, W, depth, z, h, h_far, quads, Ry=None, growth=GROWTH):
         raise RuntimeError(f"hertz: longest edge in the zone is {ratio:.3f} h after 5 meshings")
 
 
+def _layer_points(r, X_end, Y_end, z, bottom):
+    """Layers (K, 5, 2) of one body on the layer radii r (0 ... r_end): the U of half-width X
+    and height Y, X = Y = r on the zone (r <= z), then blended linearly to the body's X_end and
+    Y_end at r_end; bottom(X): the ends' height (the body's boundary), the arms rise (Y > 0) or
+    fall (Y < 0: the block below the origin) from there."""
+    f = np.clip((r - z) / (r[-1] - z), 0.0, 1.0)
+    X = np.where(r <= z, r, z + f * (X_end - z))
+    Y = np.where(r <= z, r, z + f * (abs(Y_end) - z)) * np.sign(Y_end)
+    b, o = bottom(X), np.zeros_like(X)
+    return np.stack(
+        [np.column_stack(q) for q in ((-X, b), (-X, Y), (o, Y), (X, Y), (X, b))], axis=1
+    )
+
+
+def _layers(R, Ry, W, depth, z, h, h_far, growth):
+    """Rank 0: both bodies as nested layers around the origin (meshes/layers.py): spacing
+    h / sqrt(2) on the zone (the grid's diagonals h), growing by the ratio 1 + growth per layer
+    up to h_far. Returns x (n, 2), triangles (m, 3) int64."""
+    from .cut import graded_lines
+    from .layers import layer_mesh
+
+    s = h / np.sqrt(2)
+    z = s * np.ceil(z / s - 1e-9)  # the zone: whole layers of spacing s
+
+    def body(X_end, Y_end, bottom):
+        r = graded_lines(0.0, max(X_end, abs(Y_end)), (0.0, z), s, 1 + growth, h_far)
+        spacing = np.maximum(np.gradient(r), s)
+        return layer_mesh(_layer_points(r, X_end, Y_end, z, bottom), spacing)
+
+    xb, tb = body(W, -depth, np.zeros_like)
+    xc, tc = body(R, Ry, lambda X: ellipse_sag(R, Ry, np.minimum(X, R)))
+    return np.concatenate([xb, xc]), np.concatenate([tb, tc + len(xb)]).astype(np.int64)
+
+
 def indenter_shape(R, Ry):
     """The indenter's full ellipse (circle if Ry == R) centred at (0, Ry): a dolfinx_forms
     shape, < 0 inside, its signed distance exact."""
@@ -202,14 +246,20 @@ def hertz_scene(
     Ry=None,
     growth=GROWTH,
     band=None,
+    mesher="gmsh",
 ) -> Scene:
     """The Hertz scene (see the module docstring): a half-ellipse of semi-axes R (horizontal)
     and Ry (vertical, default R: the half-cylinder) on the block; contact_box overrides
-    hertz_contact_box(R, width, depth, zone, Ry, band, h) (band: the contact problem's)."""
+    hertz_contact_box(R, width, depth, zone, Ry, band, h) (band: the contact problem's).
+    mesher: "gmsh" or "layers" (triangles without gmsh, see `MESHERS`)."""
     import dolfinx_forms as df
 
     Ry = R if Ry is None else float(Ry)
     check_mesh_size(R, width, depth, h, zone, Ry)
+    if mesher not in MESHERS:
+        raise ValueError(f"mesher {mesher!r} not in {MESHERS}")
+    if mesher == "layers" and quads:
+        raise ValueError("mesher 'layers' makes triangles only (quads: mesher 'gmsh')")
     h_far = max(h, min(R, Ry, depth) / 8 if h_far is None else h_far)
     W = width / 2
     bodies = [
@@ -239,12 +289,19 @@ def hertz_scene(
         "cylinder_top": (4, lambda x: np.isclose(x[1], Ry, atol=tol), 1),
         "cylinder_arc": (5, on_arc, 1),
     }
+    box = contact_box
+    if box is None:
+        box = hertz_contact_box(R, width, depth, zone, Ry, band, h)
+    if mesher == "layers":
+        x, cells = (
+            _layers(R, Ry, W, depth, zone, h, h_far, growth)
+            if comm.rank == 0
+            else (np.zeros((0, 2)), np.zeros((0, 3), np.int64))
+        )
+        return scene_from_arrays(comm, x, cells, "triangle", bodies, markers, [(0, 1)], h, box)
     with gmsh_model(comm, "hertz") as gmsh:
         if comm.rank == 0:
             _build(gmsh, R, W, depth, zone, h, h_far, quads, Ry, growth)
-        box = contact_box
-        if box is None:
-            box = hertz_contact_box(R, width, depth, zone, Ry, band, h)
         return scene_from_gmsh(comm, bodies, markers, [(0, 1)], h, contact_box=box)
 
 

@@ -40,6 +40,7 @@ __all__ = [
     "Body",
     "Scene",
     "scene_from_gmsh",
+    "scene_from_arrays",
     "gmsh_model",
     "check_cells",
     "contact_partitioner",
@@ -487,16 +488,44 @@ def scene_from_gmsh(
     _state["status_pending"] = False
     if status[0] != "ok":
         raise RuntimeError(status[1])
-    gtype = status[1]
-    cell_name, nv = _GMSH_CELLS[gtype]
+    cell_name, nv = _GMSH_CELLS[status[1]]
     if comm.rank != 0:
         x, cells = np.zeros((0, 2)), np.zeros((0, nv), np.int64)
+    return scene_from_arrays(
+        comm,
+        x,
+        cells,
+        cell_name,
+        bodies,
+        boundary_markers,
+        pairs,
+        h_contact,
+        contact_box,
+        ghost_mode,
+    )
 
-    import dolfinx.io.gmshio
+
+def scene_from_arrays(
+    comm,
+    x,
+    cells,
+    cell_name,
+    bodies,
+    boundary_markers,
+    pairs,
+    h_contact,
+    contact_box=None,
+    ghost_mode=None,
+) -> Scene:
+    """Collective: the Scene of the first-order cells (m, nv) int64 (DOLFINx vertex order) on
+    the nodes x (n, 2) given on rank 0 (the other ranks pass empty arrays of those shapes);
+    cell_name "triangle" or "quadrilateral", on every rank. The other arguments as in
+    :func:`scene_from_gmsh`, which converts gmsh's mesh and calls this."""
     import dolfinx.mesh
+    import ufl
 
     ghost_mode = dolfinx.mesh.GhostMode.shared_facet if ghost_mode is None else ghost_mode
-    domain = dolfinx.io.gmshio.ufl_mesh(gtype, 2)
+    domain = ufl.Mesh(ufl.VectorElement("Lagrange", getattr(ufl, cell_name), 1))
     kwargs = partitioner_kwargs(comm, x, cells, cell_name, contact_box, bodies, pairs, h_contact)
     mesh = dolfinx.mesh.create_mesh(comm, cells, x, domain, ghost_mode=ghost_mode, **kwargs)
 

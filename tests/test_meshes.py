@@ -48,6 +48,11 @@ SCENES = {
             "cylinder_arc": ("cylinder", lambda x: close(np.hypot(x[:, 0], x[:, 1] - R), R), None),
         },
     ),
+    "hertz_layers": (  # the same scene meshed without gmsh (meshes/layers.py), triangles only
+        lambda q: hertz_scene(MPI.COMM_SELF, h=0.2, mesher="layers"),
+        {"block": 2 * W * D, "cylinder": None},
+        {},  # "hertz"'s, below
+    ),
     "two_blocks": (
         lambda q: two_blocks_scene(MPI.COMM_SELF, h=2.0, quads=q),
         {"lower": 400.0, "upper": 200.0},
@@ -88,6 +93,7 @@ SCENES = {
         },
     ),
 }
+SCENES["hertz_layers"][2].update(SCENES["hertz"][2])
 _cache = {}
 
 
@@ -118,7 +124,8 @@ def facet_points(s, name):
     return facets, s.mesh.geometry.x[g][..., :2]
 
 
-CASES = [(n, q) for n in SCENES for q in (False, True)]
+CASES = [(n, q) for n in SCENES for q in (False, True) if not (n == "hertz_layers" and q)]
+HERTZ = [("hertz", False), ("hertz", True), ("hertz_layers", False)]
 
 
 @pytest.mark.parametrize("name,quads", CASES)
@@ -158,13 +165,13 @@ def test_areas_exact(name, quads):
             assert np.isclose(a[tags == b.tag].sum(), exact, rtol=1e-10), b.name
 
 
-@pytest.mark.parametrize("quads", [False, True])
-def test_hertz_arc(quads):
+@pytest.mark.parametrize("name,quads", HERTZ)
+def test_hertz_arc(name, quads):
     """Half-disc area: mesh area + the circular segments cut off by the arc facets = pi R^2 / 2
     (to round-off: the arc nodes lie on the circle). The chord error itself is O(h^2): a chord c
     cuts off R^2/2 (t - sin t) ~ c^3 / (12 R), t = 2 asin(c / 2R), so the total over arc length
     pi R is <= pi R c_max^2 / (12 R), i.e. relative to pi R^2 / 2 at most c_max^2 / (6 R^2)."""
-    s = scene("hertz", quads)
+    s = scene(name, quads)
     x, cells, tags = local_cells(s)
     mesh_area = areas(x, cells)[tags == 2].sum()
     _, p = facet_points(s, "cylinder_arc")
@@ -201,10 +208,15 @@ def test_facet_tags(name, quads):
     assert np.all(np.diff(s.facet_tags.indices) > 0)
 
 
-@pytest.mark.parametrize("quads", [False, True])
+@pytest.mark.parametrize("name,quads", HERTZ)
 @pytest.mark.parametrize("h", [0.2, 0.1])
-def test_hertz_mesh_size(h, quads):
-    s = hertz_scene(MPI.COMM_SELF, h=h, quads=quads) if h != 0.2 else scene("hertz", quads)
+def test_hertz_mesh_size(h, name, quads):
+    mesher = "layers" if name == "hertz_layers" else "gmsh"
+    s = (
+        scene(name, quads)
+        if h == 0.2
+        else hertz_scene(MPI.COMM_SELF, h=h, quads=quads, mesher=mesher)
+    )
     x, cells, _ = local_cells(s)
     zone = [[-1.5, -1.5], [1.5, 1.5]]
     assert s.h_contact == h
@@ -213,7 +225,8 @@ def test_hertz_mesh_size(h, quads):
     lo, hi = cell_bboxes(x, cells)
     inside = np.all((lo >= -1.5) & (hi <= 1.5), axis=1)
     assert cell_edges(x, cells[inside]).mean() > (0.6 if not quads else 0.8) * h
-    assert areas(x, cells[inside]).sum() > 0.9 * 2 * 3.0 * 1.5
+    # layers: the cells across |x| = 1.5 or y = +-1.5 (layers h / sqrt(2) apart) do not count
+    assert areas(x, cells[inside]).sum() > (0.85 if mesher == "layers" else 0.9) * 2 * 3.0 * 1.5
 
 
 def test_patch_nonmatching():
@@ -244,12 +257,13 @@ def test_gmsh_left_as_found():
 
 
 @pytest.mark.mpi
-@pytest.mark.parametrize("quads", [False, True])
-def test_contact_box_cells_on_rank0(quads):
+@pytest.mark.parametrize("name,quads", HERTZ)
+def test_contact_box_cells_on_rank0(name, quads):
     comm = MPI.COMM_WORLD
     assert comm.size == 2, "this test is meant for mpirun -n 2"
-    s = hertz_scene(comm, h=0.2, quads=quads)
-    serial = hertz_scene(MPI.COMM_SELF, h=0.2, quads=quads)
+    mesher = "layers" if name == "hertz_layers" else "gmsh"
+    s = hertz_scene(comm, h=0.2, quads=quads, mesher=mesher)
+    serial = hertz_scene(MPI.COMM_SELF, h=0.2, quads=quads, mesher=mesher)
     m = s.mesh
     nloc = m.topology.index_map(2).size_local
     x, cells, tags = local_cells(s)
