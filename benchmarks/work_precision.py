@@ -9,9 +9,12 @@ discretization variant. Variants: the body-fitted (gmsh) path p1-tri, p2-tri, p1
 (hertz.py [--degree 2] [--quads]) and the cut path q1-cut (hertz.py --discretization cut:
 level sets on a graded structured grid, Q1, hertz.py's default ghost penalty), each with the
 default penalty; p1-tri-al and q1-cut-al the same with --enforcement augmented (P1
-multipliers, point-wise traction, --multiplier-mass lumped: the closest pressure); q1-cut-al-z1 is q1-cut-al with the fine zone just covering
-the contact (--zone 1.0, see dolfinx_forms/study.py). Default p1-tri,p1-quad,q1-cut,p1-tri-al,
-q1-cut-al,q1-cut-al-z1, so one run compares both paths and both enforcements.
+multipliers, point-wise traction, --multiplier-mass lumped: the closest pressure); q1-cut-al-z1
+is q1-cut-al with the fine zone just covering the contact (--zone 1.0, see
+dolfinx_forms/study.py); p1-tri-layers the body-fitted P1 triangles meshed without gmsh
+(--mesher layers: meshes/layers.py) with --zone 1.0 --grading 0.5. Default p1-tri,p1-quad,
+q1-cut,p1-tri-al,q1-cut-al,q1-cut-al-z1,p1-tri-layers, so one run compares both paths, both
+enforcements and both meshers.
 
 GetFEM. When `import getfem` works (Debian's python3-getfem; `make bench` installs it) the same
 run also runs benchmarks/getfem_hertz.py (GetFEM's nodal P1 contact between the two bodies,
@@ -122,7 +125,7 @@ REF_KEY = "pressure_rel_l2_error_ref"
 PROFILE_SAMPLES = 6001  # uniform points on [-1.5 a, 1.5 a] of the error against the reference
 BEST_TIE = 0.02  # GetFEM runs within 2 % of its smallest error are ties: the fastest is "best"
 # p2-tri is selectable (about 8 minutes alone); -al: augmented Lagrangian enforcement
-DEFAULT_VARIANTS = "p1-tri,p1-quad,q1-cut,p1-tri-al,q1-cut-al,q1-cut-al-z1"
+DEFAULT_VARIANTS = "p1-tri,p1-quad,q1-cut,p1-tri-al,q1-cut-al,q1-cut-al-z1,p1-tri-layers"
 QUICK_VARIANTS = "p1-tri,q1-cut"
 TARGET = 0.02  # pressure L2 error of the time-to-precision figure
 
@@ -574,6 +577,7 @@ COLORS = {
     "p1-tri-al": "tab:cyan",
     "q1-cut-al": "tab:pink",
     "q1-cut-al-z1": "tab:olive",
+    "p1-tri-layers": "tab:brown",
     GETFEM_VARIANT: "k",
 }
 PHASE_COLORS = {

@@ -320,6 +320,12 @@ VARIANTS = {  # name -> hertz.py arguments selecting the discretisation
     # 1.19 / 0.89 / 0.83 / 0.85 / 0.72 % at 1.2 a, loads 350 and 520 alike); the penalty's error
     # grows there instead (1.92 / 1.67 / 1.44 % against 1.78 / 1.52 / 1.33 % at a/20 ... a/28)
     "q1-cut-al-z1": [*AL_LUMPED_CUT, "--zone", "1.0"],
+    # body-fitted P1 triangles meshed in layers around the contact (meshes/layers.py, no gmsh:
+    # gmsh's library load and meshing were 0.3-0.5 s of a 0.6 s run at a/20), the fine zone
+    # just covering the contact and the size doubling every 2 layers away from it (a/20 ...
+    # a/32: 1.03 / 0.86 / 0.80 / 0.66 % against 1.06 / 0.91 / 0.79 / 0.67 % with the demo's
+    # zone 1.2 a and slope 0.25, at 2/3 of the dofs)
+    "p1-tri-layers": ["--mesher", "layers", "--zone", "1.0", "--grading", "0.5"],
 }
 ERROR_LABELS = {
     "half_width_rel_error": "a",

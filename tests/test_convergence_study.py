@@ -114,6 +114,7 @@ def test_work_precision_shares_the_runner():
         "p1-tri-al",
         "q1-cut-al",
         "q1-cut-al-z1",
+        "p1-tri-layers",
     ]
     # the augmented variants with the projection they were measured with (the closest p(x))
     al = wp.VARIANTS["q1-cut-al"]
