@@ -295,12 +295,14 @@ def split_segments(pieces, cells, piece, t, tol):
     return np.stack([x0, x1], axis=1), cells[k].astype(np.int32)
 
 
-def label_breaks(pieces, labels, tol, iterations=36, label=None):
+def label_breaks(pieces, labels, tol, iterations=36, label=None, branching=8):
     """Where the integer labels of the points of the (m, 2, 2) `pieces` change along them
     (`labels(points)` -> (n, k), e.g. the cells that hold the closest points on each body):
-    for each label that differs between a piece's ends, its first change, by bisection to
-    2^-iterations of the piece (below tol for pieces up to ~6 h / grid_refine long at
-    tol = 1e-10 dx). Labels are read tol (a length, at least `split_segments`' shortest piece;
+    for each label that differs between a piece's ends, its first change, by a search that
+    reads `branching` - 1 points of each bracket per round (a power of 2: rounds of log2 of it
+    bisections, the same dyadic points; each read is a projection call whose cost is mostly
+    its overhead) to 2^-iterations of the piece (below tol for pieces up to ~6 h / grid_refine
+    long at tol = 1e-10 dx). Labels are read tol (a length, at least `split_segments`' shortest piece;
     above the closest points' own error, or that error reads as a change at every cut made)
     inside the ends, so a change closer to an end is ignored. One change per label and round:
     call it again on the split pieces for more. label(points, col) -> (n,): the label col[i]
@@ -316,10 +318,17 @@ def label_breaks(pieces, labels, tol, iterations=36, label=None):
         def label(points, col):
             return labels(points)[np.arange(len(points)), col]
 
-    for _ in range(iterations):
-        mid = 0.5 * (lo + hi)
-        same = label(a[k] + mid[:, None] * (b[k] - a[k]), col) == la[k, col]
-        lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
+    levels = int(round(np.log2(branching)))
+    j = np.arange(1, branching) / branching  # exact: dyadic fractions of the bracket
+    for _ in range(-(-iterations // levels)):
+        t = lo[:, None] + (hi - lo)[:, None] * j  # (n, branching - 1)
+        x = a[k, None] + t[..., None] * (b[k] - a[k])[:, None]
+        same = label(x.reshape(-1, 2), np.repeat(col, len(j))).reshape(t.shape)
+        same = same == la[k, col][:, None]
+        first = np.argmin(same, axis=1)  # the first point past the change (none: the end)
+        first[same.all(axis=1)] = len(j)
+        edges = np.column_stack([lo, t, hi])
+        lo, hi = edges[np.arange(len(lo)), first], edges[np.arange(len(lo)), first + 1]
     return k, 0.5 * (lo + hi)
 
 

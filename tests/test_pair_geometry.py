@@ -135,7 +135,7 @@ def test_near_box_leaves_the_contact_unchanged(hertz, monkeypatch):
 
 
 def test_split_segments_and_label_breaks():
-    """Pieces split where a label of their points changes (bisection), never into pieces
+    """Pieces split where a label of their points changes (a k-ary search), never into pieces
     shorter than tol, and the ends of the multiplier elements along a chain."""
     from dolfinx_forms.contact import label_breaks, multiplier_breaks, split_segments
 
@@ -154,6 +154,11 @@ def test_split_segments_and_label_breaks():
     ends = np.sort(np.unique(np.round(segs[..., 0].ravel(), 12)))
     assert np.allclose(ends, [0.0, 0.3, 0.7, 1.0, 1.6, 2.0], atol=1e-12)
     assert set(cells.tolist()) == {7, 8}
+    # the first change of a piece, in one round, whatever the search's branching (a change
+    # back to the first label inside a bracket hides nothing: the first point past it is read)
+    for branching in (2, 8, 16):
+        k, t = label_breaks(pieces[:1], labels, 1e-10, branching=branching)
+        assert list(k) == [0] and abs(t[0] - 0.3) < 1e-10, (branching, t)
     # every piece has one label along it
     mid = 0.5 * (segs[:, 0] + segs[:, 1])
     assert np.array_equal(labels(segs[:, 0] * 0.999 + mid * 0.001), labels(mid))
