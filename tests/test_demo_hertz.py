@@ -202,6 +202,9 @@ def test_patch_test_stiff_penalty_tends_to_exact(tmp_path, args):
         ("hertz.py", ["--bogus", "1"], "--bogus"),
         ("hertz.py", ["--tangential", "0.5"], "--tangential"),
         ("hertz.py", ["--multiplier-mass", "consistent"], "--multiplier-mass"),  # penalty
+        ("hertz.py", ["--mesher", "layers", "--quads"], "--mesher"),  # triangles only
+        ("hertz.py", ["--mesher", "layers", "--discretization", "cut"], "--mesher"),
+        ("hertz.py", ["--mesher", "delaunay"], "--mesher"),
         ("patch_test.py", ["--h", "0.3"], "--h"),
         ("patch_test.py", ["--nu", "0.7"], "--nu"),
         ("patch_test.py", ["--discretization", "cut", "--interface", "0.5"], "--interface"),

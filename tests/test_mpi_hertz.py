@@ -1,5 +1,6 @@
 """Hertz contact on 2 MPI ranks gives the reaction of 1 rank (run under mpirun -n 2),
-body-fitted and cut (cut cells, ghost-penalty facets across the partition boundary).
+body-fitted (gmsh or layers) and cut (cut cells, ghost-penalty facets across the partition
+boundary).
 
 The scene partitioner puts every cell of the contact search box on rank 0, so the contact
 points and both bodies' cells around them are local there; the other rank only assembles
@@ -23,6 +24,8 @@ def reaction(comm, mu, disc="conforming", enforcement="penalty", band=0.13, box=
     # "augmented/consistent": its mass ("augmented": the lumped one, "augmented/hybrid" the default)
     enforcement, _, mass = enforcement.partition("/")
     make = hertz_cut_scene if disc == "cut" else hertz_scene
+    if disc == "layers":  # body-fitted, meshed by meshes/layers.py
+        size["mesher"] = "layers"
     size = {**dict(R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.6), **size}
     scene = make(comm, **size, band=box)
     mat = {b.tag: (1e4, 0.3) for b in scene.bodies}
@@ -63,6 +66,7 @@ def reaction(comm, mu, disc="conforming", enforcement="penalty", band=0.13, box=
         (0.3, "cut", "augmented/consistent"),  # Uzawa's L2 projection, unclipped
         (0.3, "conforming", "augmented/hybrid"),  # consistent rows in contact, lumped at the edge
         (0.0, "cut", "augmented/hybrid"),
+        (0.3, "layers", "penalty"),
     ],
 )
 def test_two_ranks_match_one(mu, disc, enforcement):
