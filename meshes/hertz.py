@@ -15,11 +15,13 @@ vertex), the rest is meshed at 2h, recombined and subdivided (all quads); triang
 unstructured with gmsh target ~0.75 h (mean edge ~0.75 h), shrunk and remeshed if an edge
 exceeds 1.05 h.
 Outside the zone the size grows linearly with slope 0.25 up to h_far (default
-min(R, Ry, depth)/8). The zone must lie inside both bodies: zone < min(R, Ry, width/2, depth),
+min(R, Ry, depth)/8). mesher="layers" (triangles only, no gmsh): nested layers around the
+origin (meshes/layers.py), h / sqrt(2) apart on the zone (the block's cells halves of squares,
+edges h / sqrt(2) and h), the spacing growing by 1 + growth per layer outside, up to h_far. The zone must lie inside both bodies: zone < min(R, Ry, width/2, depth),
 and the arc below y = zone at x = +-zone.
 Boundaries (facet tags): block_bottom=1, block_sides=2, block_top=3, cylinder_top=4, cylinder_arc=5.
 pairs = [(0, 1)]; the contact box [-1.5 zone, 1.5 zone]^2 (clipped to the scene) is on rank 0.
-Run: /usr/bin/python3 -m meshes.hertz [--h 0.05] [--quads] [--R 10] [--Ry 6]
+Run: /usr/bin/python3 -m meshes.hertz [--h 0.05] [--quads] [--R 10] [--Ry 6] [--layers]
      (from the repository root)
 """
 
@@ -315,7 +317,12 @@ if __name__ == "__main__":
     ap.add_argument("--quads", action="store_true")
     ap.add_argument("--R", type=float, default=10.0, help="horizontal semi-axis")
     ap.add_argument("--Ry", type=float, default=None, help="vertical semi-axis (default R)")
+    ap.add_argument("--layers", action="store_true", help="mesher 'layers' (no gmsh)")
     args = ap.parse_args()
-    line = summary(hertz_scene(MPI.COMM_WORLD, R=args.R, h=args.h, quads=args.quads, Ry=args.Ry))
+    mesher = "layers" if args.layers else "gmsh"
+    scene = hertz_scene(
+        MPI.COMM_WORLD, R=args.R, h=args.h, quads=args.quads, Ry=args.Ry, mesher=mesher
+    )
+    line = summary(scene)
     if MPI.COMM_WORLD.rank == 0:
         print("hertz:", line)
