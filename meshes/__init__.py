@@ -1,4 +1,5 @@
-"""Verification scenes for the contact code: gmsh-built, multi-body DOLFINx meshes.
+"""Verification scenes for the contact code: gmsh-built (Hertz also gmsh-free, in layers:
+`layers.py`), multi-body DOLFINx meshes.
 
 Each generator returns a :class:`Scene` (one mesh holding all bodies, disjoint, with body
 cell tags, named boundary facet tags, exact signed-distance shapes and contact pairs).
@@ -7,7 +8,14 @@ gmsh runs on rank 0 only; call the generators collectively on `comm`:
     from meshes import hertz_scene, two_blocks_scene, incline_scene, patch_scene
 """
 
-from .scene import Body, Scene, gmsh_model, scene_from_gmsh, summary  # noqa: F401
+from .scene import (  # noqa: F401
+    Body,
+    Scene,
+    gmsh_model,
+    scene_from_arrays,
+    scene_from_gmsh,
+    summary,
+)
 
 _GENERATORS = {
     "hertz_scene": "hertz",
@@ -16,7 +24,15 @@ _GENERATORS = {
     "incline_scene": "incline",
     "patch_scene": "patch",
 }
-__all__ = ["Body", "Scene", "gmsh_model", "scene_from_gmsh", "summary", *_GENERATORS]
+__all__ = [
+    "Body",
+    "Scene",
+    "gmsh_model",
+    "scene_from_arrays",
+    "scene_from_gmsh",
+    "summary",
+    *_GENERATORS,
+]
 
 
 def __getattr__(name):
