@@ -78,9 +78,19 @@ def zip_strips(x, a_start, a_count, b_start, b_count, direction, a_first):
 
 
 def _counter_clockwise(x, tri):
+    """tri reordered counter-clockwise; ValueError for a triangle of no area (two rows that
+    are not apart: a layout whose layers touch)."""
     p = x[tri]
     d1, d2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
     area = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+    if len(area):
+        scale = max(np.ptp(x[:, 0]), np.ptp(x[:, 1])) ** 2
+        bad = np.abs(area) <= 1e-14 * scale
+        if bad.any():
+            raise ValueError(
+                f"layers: {int(bad.sum())} triangle(s) of no area, the first at "
+                f"{p[bad][0].mean(axis=0)} (two layers not apart there)"
+            )
     flip = area < 0
     tri[flip] = tri[flip][:, [0, 2, 1]]
     return tri

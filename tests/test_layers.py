@@ -138,3 +138,11 @@ def test_hertz_layers(R, Ry, h, growth):
     eb = e[in_block]
     assert np.all(np.isclose(eb, h / np.sqrt(2), rtol=1e-9) | np.isclose(eb, h, rtol=1e-9))
     assert 0.6 * h < e.min() and e.max() <= 1.1 * h
+
+
+def test_touching_layers_refused():
+    """Two layers that coincide over a side make triangles of no area: refused by name."""
+    P, sp = block_layers()
+    P[2, 1:4, 1] = P[1, 1:4, 1]  # layer 2's bottom on layer 1's
+    with pytest.raises(ValueError, match="no area"):
+        layer_mesh(P, sp)
