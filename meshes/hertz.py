@@ -260,6 +260,11 @@ def hertz_scene(
     check_mesh_size(R, width, depth, h, zone, Ry)
     if mesher not in MESHERS:
         raise ValueError(f"mesher {mesher!r} not in {MESHERS}")
+    if not ellipse_sag(R, Ry, zone) < zone:  # the corner (zone, zone) outside the indenter
+        raise ValueError(
+            f"zone {zone:.4g} must lie inside both bodies: the indenter's arc at x = zone is at "
+            f"y = {ellipse_sag(R, Ry, zone):.4g}, above y = zone (use a smaller zone or Ry)"
+        )
     if mesher == "layers" and quads:
         raise ValueError("mesher 'layers' makes triangles only (quads: mesher 'gmsh')")
     h_far = max(h, min(R, Ry, depth) / 8 if h_far is None else h_far)

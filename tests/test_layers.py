@@ -146,3 +146,15 @@ def test_touching_layers_refused():
     P[2, 1:4, 1] = P[1, 1:4, 1]  # layer 2's bottom on layer 1's
     with pytest.raises(ValueError, match="no area"):
         layer_mesh(P, sp)
+
+
+def test_zone_outside_the_indenter_refused():
+    """A zone whose corner (zone, zone) lies outside a slender indenter (R = 0.5, Ry = 10:
+    its arc is at y = 0.84 at x = 0.2) would fold the layers over: refused before meshing."""
+    from mpi4py import MPI
+
+    from meshes.hertz import hertz_scene
+
+    for mesher in ("layers", "gmsh"):
+        with pytest.raises(ValueError, match="zone 0.2 must lie inside both bodies"):
+            hertz_scene(MPI.COMM_SELF, R=0.5, Ry=10.0, h=0.01, zone=0.2, mesher=mesher)

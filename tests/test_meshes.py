@@ -295,13 +295,23 @@ def test_contact_box_cells_on_rank0(name, quads):
 
 
 @pytest.mark.mpi
-def test_build_error_raises_on_all_ranks():
+def test_build_error_raises_on_all_ranks(monkeypatch):
     comm = MPI.COMM_WORLD
     assert comm.size == 2
-    with pytest.raises((AssertionError, RuntimeError)):
-        # the tall arc rises above the zone's top at x = zone: fails in gmsh's build, rank 0
-        # (a zone larger than the bodies is refused on every rank first: mesh_size_bounds)
-        hertz_scene(comm, R=2.0, Ry=20.0, h=0.2, zone=1.9)
+    import meshes.hertz
+
+    def fail(*args, **kwargs):  # gmsh's build runs on rank 0 only
+        raise RuntimeError("gmsh build failed")
+
+    monkeypatch.setattr(meshes.hertz, "_build", fail)
+    with pytest.raises(RuntimeError, match="gmsh build failed"):
+        hertz_scene(comm, h=0.2)
+    comm.Barrier()
+    # the tall arc rising above the zone's top at x = zone: refused on every rank, before
+    # any meshing (it would fold the layers, and gmsh's zone over)
+    for mesher in ("gmsh", "layers"):
+        with pytest.raises(ValueError, match="must lie inside both bodies"):
+            hertz_scene(comm, R=2.0, Ry=20.0, h=0.2, zone=1.9, mesher=mesher)
     comm.Barrier()
 
 
