@@ -301,17 +301,18 @@ def label_breaks(pieces, labels, tol, iterations=36, label=None, branching=8):
     for each label that differs between a piece's ends, its first change, by a search that
     reads `branching` - 1 points of each bracket per round (a power of 2: rounds of log2 of it
     bisections, the same dyadic points; each read is a projection call whose cost is mostly
-    its overhead) to 2^-iterations of the piece (below tol for pieces up to ~6 h / grid_refine
-    long at tol = 1e-10 dx). Labels are read tol (a length, at least `split_segments`' shortest piece;
-    above the closest points' own error, or that error reads as a change at every cut made)
-    inside the ends, so a change closer to an end is ignored. One change per label and round:
-    call it again on the split pieces for more. label(points, col) -> (n,): the label col[i]
-    of points[i] alone (default: labels(points) read there), for a bisection that reads one
-    label per point. Returns (piece, t) pairs for `split_segments`."""
+    its overhead) to 2^-iterations of the piece (below tol for pieces up to ~6 h /
+    grid_refine long at tol = 1e-10 dx). Labels are read tol (a length, at least
+    `split_segments`' shortest piece; above the closest points' own error, or that error reads
+    as a change at every cut made) inside the ends, so a change closer to an end is ignored.
+    One change per label and round: call it again on the split pieces for more.
+    label(points, col) -> (n,): the label col[i] of points[i] alone (default: labels(points)
+    read there), for a search that reads one label per point. Returns (piece, t) pairs for
+    `split_segments`."""
     a, b = pieces[:, 0], pieces[:, 1]
     inset = np.minimum(tol / np.maximum(np.linalg.norm(b - a, axis=1), 1e-300), 0.25)[:, None]
     la, lb = labels(a + inset * (b - a)), labels(b - inset * (b - a))
-    k, col = np.nonzero(la != lb)  # one bisection per (piece, label) that changes
+    k, col = np.nonzero(la != lb)  # one search per (piece, label) that changes
     lo, hi = inset[k, 0], 1.0 - inset[k, 0]
     if label is None:
 

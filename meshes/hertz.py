@@ -17,8 +17,9 @@ exceeds 1.05 h.
 Outside the zone the size grows linearly with slope 0.25 up to h_far (default
 min(R, Ry, depth)/8). mesher="layers" (triangles only, no gmsh): nested layers around the
 origin (meshes/layers.py), h / sqrt(2) apart on the zone (the block's cells halves of squares,
-edges h / sqrt(2) and h), the spacing growing by 1 + growth per layer outside, up to h_far. The zone must lie inside both bodies: zone < min(R, Ry, width/2, depth),
-and the arc below y = zone at x = +-zone.
+edges h / sqrt(2) and h), the spacing growing by 1 + growth per layer outside, up to h_far.
+The zone must lie inside both bodies: zone < min(R, Ry, width/2, depth), and the arc below
+y = zone at x = +-zone (ValueError otherwise, on every rank).
 Boundaries (facet tags): block_bottom=1, block_sides=2, block_top=3, cylinder_top=4, cylinder_arc=5.
 pairs = [(0, 1)]; the contact box [-1.5 zone, 1.5 zone]^2 (clipped to the scene) is on rank 0.
 Run: /usr/bin/python3 -m meshes.hertz [--h 0.05] [--quads] [--R 10] [--Ry 6] [--layers]
