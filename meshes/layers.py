@@ -131,9 +131,11 @@ def layer_nodes(points, spacing):
 def layer_mesh(points, spacing):
     """(x (n, 2), triangles (m, 3) int64) of the layers points (K, 5, 2) (module docstring,
     points[0]: O five times, points[-1]: the body's outline) at the spacings (K,). Sides 0 and 3
-    are the U's arms, 1 and 2 its halves either side of the middle Q2: ties step the inner row
-    first on sides 2 and 3 and the outer one on sides 0 and 1, their mirror images run the other
-    way, so a layout symmetric about the vertical through Q2 gives a mirror-symmetric mesh."""
+    are the U's arms, 1 and 2 its halves either side of the middle Q2. Ties step the inner row
+    first on sides 0 and 2 and the outer one on sides 1 and 3: the mirror image of side 0 is
+    side 3 run backwards (of side 1, side 2), and a merge run backwards takes the other
+    diagonal at a tie, so a layout symmetric about the vertical through Q2 gives a
+    mirror-symmetric mesh (tested)."""
     P = np.asarray(points, float)
     x, starts = layer_nodes(P, spacing)
     K = len(P)
