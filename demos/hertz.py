@@ -14,6 +14,7 @@ computed load* (the reaction), the stick half-width against c at the computed Q,
 residual history and the phase timings.
 
 Run: /usr/bin/python3 demos/hertz.py [--discretization cut] [--mu 0.3 --tangential 0.5]
+     [--mesher layers] (body-fitted triangles without gmsh: meshes/layers.py)
 Results and discussion: docs/demos.md#hertz-and-cattaneo-mindlin
 """
 
