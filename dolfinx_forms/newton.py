@@ -150,7 +150,7 @@ def newton(problem, lam, r_ref=0.0, early=0.0):
             slip = problem.contact.mu > 0 and problem.comm.allreduce(
                 int(problem.contact.state_counts()[2]), MPI.SUM
             )
-            key = None if slip else (sig, problem.contact.mu)
+            key = None if slip else (sig, problem.contact.mu, problem.contact.eps_t)
         _keep(problem, key, lazy, lam)
         r_base, sig_base, backtracks = r, sig, 0
         # the residual Newton must reach: what an iterative linear solver has to resolve
@@ -207,6 +207,9 @@ def _augmented_loop(problem, lam, residuals, depth=20):
     the contact set's `relaxation`. Stops when no
     multiplier changes by more than al_rtol of the largest traction and no gap by more than
     al_gtol h, after a solve to rtol; the solves before stop early (NewtonOptions.al_eta).
+    With friction the loop is a continuation in the tangential regularisation: it converges
+    at the contact set's eps_t_start first, then goes on from there at its eps_t_final (the
+    fixed point wanted; started from the committed tractions it can cycle, `solver`).
     Appends the inner Newton residuals to `residuals`.
     Returns (ok, augmentations: the Newton solves after the first, why)."""
     cs, comm, opts = problem.contact, problem.comm, problem.newton
@@ -233,8 +236,13 @@ def _augmented_loop(problem, lam, residuals, depth=20):
                 f"augmented Lagrangian: no progress in {opts.al_stall} updates, step {rho:.3g}"
             )
         if change <= min(opts.al_rtol * scale, gap_tol):
-            if residuals[-1] <= tolerance(problem, residuals[0]):
+            final = residuals[-1] <= tolerance(problem, residuals[0])
+            if final and (cs.mu == 0 or cs.eps_t == cs.eps_t_final):
                 return True, solves, ""
+            if final:  # continuation: from this fixed point on to the one at the final eps_t
+                cs.eps_t = cs.eps_t_final
+                gap_tol = opts.al_gtol * problem.scene.h_contact / max(cs.eps_n, cs.eps_t)
+                X, F, best, stalled = [], [], np.inf, 0
             ok, more, why = newton(problem, lam, residuals[0])  # the last solve stopped early
             residuals += more
             solves += 1

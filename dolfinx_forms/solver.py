@@ -48,6 +48,13 @@ CONSISTENT_LENGTH = 1.5
 # 1.5 (a/20: +0.1 % body-fitted, +0.35 % cut) and +0.6 ... +2.0 % at 2 (the penalty: +0.06 ...
 # +0.9 %); q(x) moves by at most 0.4 points of % over the three (docs/demos.md)
 POINTWISE_EPS0_T = 1.5
+# with multiplier_mass "consistent" or "hybrid" the tangential fixed point is at eps_t =
+# CONSISTENT_EPS0_T h / E, reached by continuation from POINTWISE_EPS0_T (each step's loop
+# converges there first: from the committed tractions Newton cycles at 1.0). Mindlin, Q = 0.5
+# mu P, 24 runs (mu 0.1 / 0.3 / 1, h = a/16 ... a/28, both paths): stick half-width off by
+# 0.17 % mean |.|, 0.40 % at most (1.5 alone: 0.49 / 0.98 %; the penalty 0.33 / 0.52 %), q(x)
+# 5.50 % mean (5.41 %; penalty 5.66 %), 23 % more time than 1.5 alone; 0.75: -0.15 ... -0.65 %
+CONSISTENT_EPS0_T = 1.0
 # below this many dofs one BLAS thread (`blas.threads_for`; measured on cut Hertz: one thread
 # as fast at 8.5k dofs and steadier, two 7 % faster at 1e5)
 BLAS_ONE_THREAD_DOFS = 50_000
@@ -217,13 +224,16 @@ class ContactProblem:
                 f"multipliers and traction 'points', got {enforcement!r}, {multipliers!r}, "
                 f"{traction!r}"
             )
-        relaxation = 1.0
+        relaxation, eps_t_start = 1.0, None
         if enforcement == "augmented" and multipliers is not None and traction == "points":
             # the point-wise regularisation is part of the discretisation; eps0 sets the step
             E_c = contact_modulus(scene, self.laws, obstacles)
             fine = (CONSISTENT_EPS0 if consistent else POINTWISE_EPS0) * h / E_c
             relaxation = min(1.0, fine / self.eps_n)
             self.eps_n, self.eps_t = fine, POINTWISE_EPS0_T * h / E_c
+            eps_t_start = self.eps_t
+            if consistent:
+                self.eps_t = CONSISTENT_EPS0_T * h / E_c
         if multiplier_length is None:
             multiplier_length = h * (
                 CONSISTENT_LENGTH if consistent else 1.5 if self.integration is not None else 1.0
@@ -247,6 +257,7 @@ class ContactProblem:
                 traction=traction,
                 relaxation=relaxation,
                 multiplier_mass=multiplier_mass,
+                eps_t_start=eps_t_start,
             )
         self.pairs = self.contact.pairs
 
