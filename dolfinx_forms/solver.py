@@ -50,10 +50,12 @@ CONSISTENT_LENGTH = 1.5
 POINTWISE_EPS0_T = 1.5
 # with multiplier_mass "consistent" or "hybrid" the tangential fixed point is at eps_t =
 # CONSISTENT_EPS0_T h / E, reached by continuation from POINTWISE_EPS0_T (each step's loop
-# converges there first: from the committed tractions Newton cycles at 1.0). Mindlin, Q = 0.5
+# nearly converges there first, `NewtonOptions.al_switch`: from the committed tractions Newton
+# cycles at 1.0). Mindlin, Q = 0.5
 # mu P, 24 runs (mu 0.1 / 0.3 / 1, h = a/16 ... a/28, both paths): stick half-width off by
 # 0.17 % mean |.|, 0.40 % at most (1.5 alone: 0.49 / 0.98 %; the penalty 0.33 / 0.52 %), q(x)
-# 5.50 % mean (5.41 %; penalty 5.66 %), 23 % more time than 1.5 alone; 0.75: -0.15 ... -0.65 %
+# 5.50 % mean (5.41 %; penalty 5.66 %), 1-2 Newton iterations more than 1.5 alone; 0.75 gave
+# -0.15 ... -0.65 %
 CONSISTENT_EPS0_T = 1.0
 # below this many dofs one BLAS thread (`blas.threads_for`; measured on cut Hertz: one thread
 # as fast at 8.5k dofs and steadier, two 7 % faster at 1e5)

@@ -375,8 +375,8 @@ def _cut_mindlin(direct):
 
 
 def test_tangential_continuation_reaches_the_final_fixed_point():
-    """With friction each step's loop converges at eps_t_start = 1.5 h/E, then goes on at
-    eps_t = 1.0 h/E (solver.CONSISTENT_EPS0_T): its answer is the loop's at 1.0 h/E alone (which
+    """With friction each step's loop nearly converges (al_switch) at eps_t_start = 1.5 h/E,
+    then goes on at eps_t = 1.0 h/E (solver.CONSISTENT_EPS0_T): its answer is the loop's at 1.0 h/E alone (which
     converges at this coarse h; at a/20 from the committed tractions it can cycle), to the
     loop's tolerance (1e-7 of the largest traction; 2e-8 seen)."""
     from dolfinx_forms.solver import CONSISTENT_EPS0_T, POINTWISE_EPS0_T
