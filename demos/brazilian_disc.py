@@ -95,9 +95,8 @@ def build(run):
         scene,
         obstacles=platens,
         dirichlet=[symmetry],
-        mu=p["mu"],
-        eps0=p["eps0"],
         timer=run.timer,
+        **run.problem_options,  # mu, eps0, --petsc, --linear-solver
     )
 
 

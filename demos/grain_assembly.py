@@ -84,9 +84,9 @@ def build(run):
         scene,
         obstacles=list(plates.values()),
         mu=np.tan(np.radians(p["friction_angle"])),
-        eps0=p["eps0"],
         predictor_gap=0.5 * p["h"],
         timer=run.timer,
+        **run.problem_options,  # eps0, --petsc, --linear-solver
     )
 
 

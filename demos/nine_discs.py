@@ -88,9 +88,8 @@ def build(run):
         [MPMBody(n, t, (p["E"], p["nu"]), s) for n, t, s in bodies],
         scene,
         dirichlet=bcs,
-        mu=p["mu"],
-        eps0=p["eps0"],
         timer=run.timer,
+        **run.problem_options,  # mu, eps0, --petsc, --linear-solver
     )
 
 

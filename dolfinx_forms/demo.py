@@ -34,7 +34,7 @@ from pathlib import Path
 from .newton import ContactSolverError
 from .results import PhaseTimer, new_metrics
 
-__all__ = ["Run", "run_case", "compute", "write", "traction_plot"]
+__all__ = ["Run", "run_case", "compute", "write", "traction_plot", "problem_options"]
 
 # parameters that Run.contact_problem passes on: {parameter: ContactProblem argument}
 PROBLEM_OPTIONS = {
@@ -49,6 +49,12 @@ PROBLEM_OPTIONS = {
     "multiplier_mass": "multiplier_mass",
     "linear_solver": "linear_solver",
 }
+
+
+def problem_options(params):
+    """The ContactProblem keywords that a run's parameters name (PROBLEM_OPTIONS): what the
+    single-stage demos and the multi-step ones (`ImplicitMPM`) pass on alike."""
+    return {arg: params[k] for k, arg in PROBLEM_OPTIONS.items() if k in params}
 
 
 @dataclass
@@ -95,7 +101,7 @@ class Run:
         p, opts = self.params, {"timer": self.timer, "dirichlet": dirichlet}
         if "E" in p:
             opts["materials"] = {b.tag: (p["E"], p["nu"]) for b in self.scene.bodies}
-        opts.update({arg: p[k] for k, arg in PROBLEM_OPTIONS.items() if k in p})
+        opts.update(problem_options(p))
         opts.update(kw)
         return ContactProblem(self.scene, opts.pop("materials"), **opts)
 

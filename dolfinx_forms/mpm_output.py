@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .demo import problem_options
 from .newton import ContactSolverError
 from .results import PhaseTimer, new_metrics
 
@@ -159,6 +160,12 @@ class StepRun:
     def analytic(self):
         return self.metrics["analytic"]
 
+    @property
+    def problem_options(self):
+        """The ContactProblem keywords its parameters name (`demo.problem_options`: mu, eps0,
+        --petsc, --linear-solver, ...), for `ImplicitMPM`."""
+        return problem_options(self.params)
+
 
 def run_steps(
     name,
@@ -221,6 +228,8 @@ def run_steps(
         converged=True,
         residual_history=[],
         penalty={"eps_n": run.sim.problem.eps_n, "eps_t": run.sim.problem.eps_t},
+        linear_solver=run.sim.problem.linear.name,  # the last step's
+        condensed_dofs=int(getattr(run.sim.problem.linear, "num_dofs", 0)),
         cutbacks=int(sum(r["cutbacks"] for r in run.records)),
         warnings=[f"step {k}: {w}" for w, k in checks.items()],
     )

@@ -65,6 +65,17 @@ def test_coarse_run_writes_the_contract(tmp_path):
     assert np.isclose(pf["left"], pf["right"], rtol=1e-8)
     assert np.isclose(pf["bottom"], pf["top"], rtol=1e-8)
     assert all(0 <= v <= 1 for v in r["stick_fraction"].values())
+    # --linear-solver reaches the MPM's problem (it was accepted and ignored): the default
+    # factorises (its contact block is too large to condense, linear.CONDENSED_COST), the
+    # condensed solver gives the same plate forces
+    assert m["solver"]["linear_solver"] == "factorised"
+    out2 = tmp_path / "fg_condensed"
+    args = ["--h", "0.2", "--steps", "1", "--out", str(out2), "--linear-solver", "condensed"]
+    assert demo.main(args) == 0
+    m2 = json.load(open(out2 / "metrics.json"))
+    assert m2["solver"]["linear_solver"] == "condensed" and m2["solver"]["condensed_dofs"] > 0
+    for k, v in m2["results"]["plate_forces"].items():
+        assert np.isclose(v, pf[k], rtol=1e-8), k
 
 
 @pytest.mark.parametrize(

@@ -139,6 +139,18 @@ def test_choice():
     assert linear.choose(pb, "auto", dict(linear.DEFAULT_OPTIONS)).name == "condensed"
 
 
+def test_auto_factorises_a_large_contact_block(monkeypatch):
+    """ "auto" condenses only where a dense update (~m^3) is cheaper than a sparse
+    factorisation (~n^1.5): with the bound at 0 every contact block is too large, and an
+    explicit "condensed" still condenses."""
+    pb = mindlin(scene("cut"), "auto")
+    m, n = len(linear.contact_dofs(pb)), pb.num_dofs
+    assert m**3 <= linear.CONDENSED_COST * n**1.5  # this scene: condensed by default
+    monkeypatch.setattr(linear, "CONDENSED_COST", 0.0)
+    assert linear.choose(pb, "auto").name == "factorised"
+    assert linear.choose(pb, "condensed").name == "condensed"
+
+
 def test_nonlinear_bulk_is_factorised():
     sc = scene("conforming")
     laws = {b.tag: NeoHookean(E, NU) for b in sc.bodies}
