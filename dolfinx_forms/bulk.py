@@ -12,17 +12,7 @@ import ufl
 from dolfinx import fem
 from petsc4py import PETSc
 
-from .laws import as_law
-
-
-def _law_key(law):
-    """Laws that are the same: one object, or a shipped law class with equal parameters (a
-    user's law is compared by identity: its UFL may hold more than its numbers)."""
-    from .laws import LAWS
-
-    if type(law) in LAWS.values():
-        return (type(law), tuple(sorted((k, v) for k, v in law.describe().items())))
-    return id(law)
+from .laws import as_law, law_key
 
 
 class BulkForms:
@@ -77,7 +67,7 @@ class BulkForms:
         # FFCx kernel, not 100)
         groups = {}
         for t, law in self.laws.items():
-            groups.setdefault(_law_key(law), (law, []))[1].append(t)
+            groups.setdefault(law_key(law), (law, []))[1].append(t)
         lin = [law.residual(u, v, measure(ts)) for law, ts in groups.values() if law.linear]
         nl = [
             law.residual(u, v, measure(ts, nonlinear=True))

@@ -146,3 +146,12 @@ def as_law(material) -> Law:
 
 
 LAWS = {"linear": LinearElastic, "orthotropic": OrthotropicElastic, "neo-hookean": NeoHookean}
+
+
+def law_key(law):
+    """Laws that are the same: one object, or a shipped law class with equal parameters (a
+    user's law is compared by identity: its UFL may hold more than its numbers). Bodies of
+    one key share one bulk integral (`bulk.BulkForms`) and one MPM tangent (`mpm`)."""
+    if type(law) in LAWS.values():
+        return (type(law), tuple(sorted((k, v) for k, v in law.describe().items())))
+    return id(law)

@@ -342,3 +342,25 @@ def test_q1_basis_is_basix_q1():
     X = np.random.default_rng(0).uniform(-0.3, 1.3, (200, 2))
     el = basix.create_element(basix.ElementFamily.P, basix.CellType.quadrilateral, 1)
     assert np.abs(q1_basis(X) - el.tabulate(1, X)[:, :, :, 0]).max() < 1e-14
+
+
+def test_binned_mean_is_the_pixel_mean():
+    """mpm_output.binned_mean (the force-chain plot's background): the mean of the values of
+    the points in each pixel, blank (NaN) where none falls, rows along y."""
+    from dolfinx_forms.mpm_output import binned_mean
+
+    # 4 points in each of the pixels (0, 0), (1, 0), (0, 1) of a 2 x 2 image of side 1
+    c = np.array([[0.25, 0.25], [0.75, 0.25], [0.25, 0.75], [0.75, 0.75]]) * 0.5
+    pix = {(0, 0): 1.0, (1, 0): 2.0, (0, 1): 3.0}
+    x = np.concatenate([c + 0.5 * np.array(ij) for ij in pix])
+    v = np.concatenate([val + np.array([-1.0, 1.0, -2.0, 2.0]) for val in pix.values()])
+    x = np.vstack([x, [[1.0, 1.0]]])  # the far corner, so the extent is the unit square
+    v = np.append(v, 7.0)
+    image, extent = binned_mean(x, v, 0.5)
+    assert image.shape == (2, 2) and np.allclose(extent, (0.125, 1.0, 0.125, 1.0))
+    # pixel edges at 0.125 + k 0.4375: each pixel holds its 4 points (the corner joins (1, 1))
+    assert np.isclose(image[0, 0], 1.0) and np.isclose(image[0, 1], 2.0)
+    assert np.isclose(image[1, 0], 3.0)
+    assert np.isclose(image[1, 1], 7.0)
+    image, _ = binned_mean(x[:-1], v[:-1], 0.25)  # finer: some pixels empty
+    assert np.isnan(image).any() and np.nanmax(image) <= 5.0
