@@ -24,7 +24,7 @@ import numpy as np
 from dolfinx_forms import cli
 from dolfinx_forms.boundary import Dirichlet
 from dolfinx_forms.mpm import ImplicitMPM, MPMBody
-from dolfinx_forms.mpm_output import run_steps
+from dolfinx_forms.mpm_output import binned_mean, run_steps
 from meshes.mpm import brazilian_disc
 
 # fmt: off
@@ -182,9 +182,8 @@ def plots(run, folder):
     fig, axes = plt.subplots(1, len(frames), figsize=(3.2 * len(frames), 3.4), squeeze=False)
     lo = min(f[2]["stress"][:, 1].min() for f in frames)
     for ax, (step, x, data, _) in zip(axes[0], frames):
-        sc = ax.scatter(
-            x[:, 0], x[:, 1], c=data["stress"][:, 1], s=0.5, cmap="viridis", vmin=lo, vmax=0
-        )
+        image, extent = binned_mean(x, data["stress"][:, 1], p["h"])
+        sc = ax.imshow(image, extent=extent, origin="lower", cmap="viridis", vmin=lo, vmax=0)
         ax.set(aspect="equal", title=f"step {step:g}", xticks=[], yticks=[])
     fig.colorbar(sc, ax=axes[0].tolist(), label="sigma_yy at the material points (N/mm^2)")
     fig.savefig(folder / "sigma_yy.png", dpi=120)

@@ -25,7 +25,7 @@ import numpy as np
 
 from dolfinx_forms import cli
 from dolfinx_forms.mpm import ImplicitMPM, MPMBody, equilibrium_error
-from dolfinx_forms.mpm_output import plot_force_chains, run_steps
+from dolfinx_forms.mpm_output import binned_mean, plot_force_chains, run_steps
 from meshes.four_grains import check_contact_zones, four_grains, grain_outlines
 from meshes.mpm import plate_face_conditions
 
@@ -176,7 +176,8 @@ def plots(run, folder):
     s1 = max_principal(np.concatenate([p.stress for p in sim.points.values()]))
     lim = np.percentile(np.abs(s1), 99.5)  # the contact peaks would wash out the rest
     fig, ax = plt.subplots(figsize=(6, 6))
-    sc = ax.scatter(x[:, 0], x[:, 1], c=s1, s=0.3, cmap="RdBu_r", vmin=-lim, vmax=lim)
+    image, extent = binned_mean(x, s1, sim.h)
+    sc = ax.imshow(image, extent=extent, origin="lower", cmap="RdBu_r", vmin=-lim, vmax=lim)
     for q in active(rec):
         ax.plot(q["x"], q["y"], "k+", ms=6)
     fig.colorbar(sc, ax=ax, label="largest principal stress (N/mm^2)", shrink=0.8)
