@@ -23,6 +23,26 @@ def hertz_pressure(x, a, p0):
     return p0 * np.sqrt(r)
 
 
+def circle_line(P, R, E_star):
+    """Half-width a and pressure scale of a cylinder on a flat whose gap is the circle's to
+    order x^4, g0 = x^2/(2R) + x^4/(8R^3), where Hertz keeps x^2/(2R) only: the load is
+    P = pi a^2 E* / (4R) (1 + 3 a^2 / (8 R^2)) (`circle_pressure`). Relative error O((a/R)^4)
+    against the exact circle on a half-plane, where Hertz's is O((a/R)^2): at a/R = 0.1 Hertz's
+    pressure is 0.4 % off the circle's in L2, most of it at the contact edge (a 0.19 % larger
+    half-width). Returns a."""
+    k, c = 4 * P * R / (np.pi * E_star), 3 / (8 * R**2)  # a^2 (1 + c a^2) = k
+    return np.sqrt(2 * k / (1 + np.sqrt(1 + 4 * c * k)))
+
+
+def circle_pressure(x, a, R, E_star):
+    """p(x) = E*/(2R) sqrt(a^2 - x^2) (1 + (x^2 + a^2/2) / (2 R^2)) inside |x| < a, the
+    half-plane solution for the gap x^2/(2R) + x^4/(8R^3) (`circle_line`): (1/pi) PV int p(s) /
+    (x - s) ds = E*/2 g0'(x), with (1/pi) PV int s^2 sqrt(a^2-s^2)/(x-s) ds = x^3 - a^2 x/2."""
+    x = np.asarray(x, float)
+    r = np.sqrt(np.clip(a**2 - x**2, 0.0, None))
+    return E_star / (2 * R) * r * (1 + (x**2 + 0.5 * a**2) / (2 * R**2))
+
+
 def load_for_half_width(a, R, E_star):
     """Line load that gives half-width a (inverse of hertz_line)."""
     return np.pi * E_star * a**2 / (4 * R)
