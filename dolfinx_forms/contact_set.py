@@ -48,11 +48,11 @@ and = 0 where the hat is all in contact; the nodes at and past the contact edge 
 row, which does not fit the square-root edge by an overshooting L2 fit. Tangential tractions
 are projected lumped (the lumped q(x)); their regularisation is continued within each step
 (eps_t_start = 1.5 h/E until the loop nearly converges, `NewtonOptions.al_switch`, then eps_t =
-1 h/E, `solver.CONSISTENT_EPS0_T`):
-at 1.5 h/E alone the smoothed multipliers let points just past the stick/slip boundary stick
-(stick zone +0.49 % mean over 24 Mindlin runs, 0.17 % with the continuation). Where the loop cycles (a row switching as points open
-and close) the rows are frozen (`freeze_rows`). Hertz a/20, loads 350-520: p(x) 0.78-1.09 %
-body-fitted, 1.12-1.50 % cut, every weighted gap < 1e-9 h (docs/demos.md).
+1 h/E, `solver.CONSISTENT_EPS0_T`): at 1.5 h/E alone the smoothed multipliers let points just
+past the stick/slip boundary stick (stick zone +0.49 % mean over 24 Mindlin runs, 0.17 % with
+the continuation). Where the loop cycles (a row switching as points open and close) the rows
+are frozen (`freeze_rows`). Hertz a/20, loads 350-520: p(x) 0.78-1.09 % body-fitted,
+1.12-1.50 % cut, every weighted gap < 1e-9 h (docs/demos.md).
 Its multipliers are left unclipped too.
 """
 

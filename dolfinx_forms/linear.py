@@ -172,8 +172,9 @@ class Condensed:
     """The bulk factorised once, Newton on the dense Schur complement of the contact dofs.
 
     The dense update costs ~m^3 and a sparse factorisation ~n^1.5 (2D): should an update take
-    longer than twice the sparse factorisation (and 50 ms), the solver hands over to `Factorised` for the
-    rest of the run (`name` then says so)."""
+    longer than twice the sparse factorisation (and 50 ms), the solver hands over to
+    `Factorised` for the rest of the run (`name` then says so); "auto" picks it only where m^3
+    <= CONDENSED_COST n^1.5 (`choose`)."""
 
     name = "condensed"
     min_handover = 0.05  # s: below this a dense update is never "too slow"

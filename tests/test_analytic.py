@@ -48,6 +48,8 @@ def test_circle_pressure_solves_the_half_plane_problem(R):
 def test_circle_line_inverts_its_load():
     P, R, E_star = 430.0, 10.0, 5494.5
     a = analytic.circle_line(P, R, E_star)
-    assert np.isclose(np.pi * a**2 * E_star / (4 * R) * (1 + 3 * a**2 / (8 * R**2)), P, rtol=1e-14)
+    assert np.isclose(
+        np.pi * a**2 * E_star / (4 * R) * (1 + 3 * a**2 / (8 * R**2)), P, rtol=1e-14
+    )
     x = np.linspace(-a, a, 400001)
     assert np.isclose(np.trapz(analytic.circle_pressure(x, a, R, E_star), x), P, rtol=1e-6)

@@ -210,10 +210,10 @@ def _cut_hertz_force(al_first, al_eta, fresh_border=False):
 
 def test_inexact_uzawa_and_border_reuse():
     """The loop's solves stop early (al_first, al_eta) and the last one goes to rtol: the same
-    state as every solve to rtol, to the loop's tolerance (al_rtol = 1e-7 of the largest traction), in
-    fewer Newton iterations. The force control's border w = J^-1 g is solved once per operator:
-    reusing it changes nothing (round-off) and saves a solve per iteration with an unchanged
-    J (the later Uzawa solves of a settled active set)."""
+    state as every solve to rtol, to the loop's tolerance (al_rtol = 1e-7 of the largest
+    traction), in fewer Newton iterations. The force control's border w = J^-1 g is solved once
+    per operator: reusing it changes nothing (round-off) and saves a solve per iteration with
+    an unchanged J (the later Uzawa solves of a settled active set)."""
     exact, _ = _cut_hertz_force(0.0, 0.0)
     early, n_reuse = _cut_hertz_force(1e-2, 1e-3)  # the defaults
     fresh, n_fresh = _cut_hertz_force(1e-2, 1e-3, fresh_border=True)
@@ -376,9 +376,9 @@ def _cut_mindlin(direct):
 
 def test_tangential_continuation_reaches_the_final_fixed_point():
     """With friction each step's loop nearly converges (al_switch) at eps_t_start = 1.5 h/E,
-    then goes on at eps_t = 1.0 h/E (solver.CONSISTENT_EPS0_T): its answer is the loop's at 1.0 h/E alone (which
-    converges at this coarse h; at a/20 from the committed tractions it can cycle), to the
-    loop's tolerance (1e-7 of the largest traction; 2e-8 seen)."""
+    then goes on at eps_t = 1.0 h/E (solver.CONSISTENT_EPS0_T): its answer is the loop's at
+    1.0 h/E alone (which converges at this coarse h; at a/20 from the committed tractions it
+    can cycle), to the loop's tolerance (1e-7 of the largest traction; 2e-8 seen)."""
     from dolfinx_forms.solver import CONSISTENT_EPS0_T, POINTWISE_EPS0_T
 
     runs = [_cut_mindlin(direct) for direct in (False, True)]
