@@ -43,6 +43,20 @@ def circle_pressure(x, a, R, E_star):
     return E_star / (2 * R) * r * (1 + (x**2 + 0.5 * a**2) / (2 * R**2))
 
 
+def circle_mindlin(P, Q, mu, R, E_star):
+    """Cattaneo-Mindlin on the circle to O((a/R)^4) (`circle_line`): the stick half-width c
+    where the circle's load of half-width c is P - |Q| / mu (the tangential traction is mu p
+    minus mu times the circle's pressure of half-width c, whose slip is uniform on |x| < c:
+    the same integral equation, identical bodies). Returns (a, c)."""
+    return circle_line(P, R, E_star), circle_line(P - abs(Q) / mu, R, E_star)
+
+
+def circle_mindlin_shear(x, a, c, R, E_star, mu):
+    """|q(x)| = mu circle_pressure(x, a) - mu circle_pressure(x, c) (`circle_mindlin`)."""
+    q = mu * circle_pressure(x, a, R, E_star)
+    return q - mu * circle_pressure(x, c, R, E_star) if c > 0 else q
+
+
 def load_for_half_width(a, R, E_star):
     """Line load that gives half-width a (inverse of hertz_line)."""
     return np.pi * E_star * a**2 / (4 * R)

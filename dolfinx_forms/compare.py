@@ -61,8 +61,10 @@ def hertz(pts, P, R, E_star, mu=0.0, Q=None):
     traction_rel_l2_error of |q(x)| while |Q| < mu P); pressure_rel_l2_error_circle against
     the pressure of the circle itself to order (a/R)^4 (`analytic.circle_pressure`: Hertz's
     parabola is 0.4 % off it at a/R = 0.1, a floor under any converging method's error against
-    Hertz); analytic: contact_half_width a, peak_pressure p0 (and stick_half_width c),
-    contact_half_width_circle; curves: {label: (x, y)} for the plot."""
+    Hertz; with friction traction_rel_l2_error_circle likewise, `analytic.circle_mindlin`);
+    analytic: contact_half_width a, peak_pressure p0 (and stick_half_width c),
+    contact_half_width_circle (and stick_half_width_circle); curves: {label: (x, y)} for the
+    plot."""
     a, p0 = analytic.hertz_line(P, R, E_star)
     x, w = pts["x"], pts["w"]
     a_c = analytic.circle_line(P, R, E_star)
@@ -86,6 +88,10 @@ def hertz(pts, P, R, E_star, mu=0.0, Q=None):
             qa = analytic.mindlin_shear(x, a, c, p0, mu)
             res["traction_rel_l2_error"] = rel_l2(w, np.abs(pts["p_t"]), qa)
             an["stick_half_width"] = c
+            _, c_c = analytic.circle_mindlin(P, Q, mu, R, E_star)
+            qc = analytic.circle_mindlin_shear(x, a_c, c_c, R, E_star, mu)
+            res["traction_rel_l2_error_circle"] = rel_l2(w, np.abs(pts["p_t"]), qc)
+            an["stick_half_width_circle"] = float(c_c)
             sign = np.sign(np.sum(pts["p_t"])) or 1.0
             curves["Cattaneo-Mindlin q(x)"] = (xs, sign * analytic.mindlin_shear(xs, a, c, p0, mu))
     return res, an, curves

@@ -53,3 +53,26 @@ def test_circle_line_inverts_its_load():
     )
     x = np.linspace(-a, a, 400001)
     assert np.isclose(np.trapz(analytic.circle_pressure(x, a, R, E_star), x), P, rtol=1e-6)
+
+
+def test_circle_mindlin_carries_Q_and_tends_to_hertz():
+    """Cattaneo-Mindlin on the circle: q = mu p_c(a) - mu p_c(c) carries Q; for a/R -> 0 the
+    stick half-width is Hertz's c = a sqrt(1 - Q / (mu P)); at a/R = 0.1 it is O((c/R)^2)
+    smaller (the circle's pressure of half-width c is the stick correction: its slip is
+    uniform on |x| < c, `test_circle_pressure_solves_the_half_plane_problem`)."""
+    E_star, mu = 5494.5, 0.3
+    for R, P, close in ((10.0, 430.0, False), (1e4, 0.43, True)):
+        Q = 0.5 * mu * P
+        a, c = analytic.circle_mindlin(P, Q, mu, R, E_star)
+        x = np.linspace(-a, a, 400001)
+        q = analytic.circle_mindlin_shear(x, a, c, R, E_star, mu)
+        assert np.isclose(np.trapz(q, x), Q, rtol=1e-6)
+        assert np.all(q >= -1e-12 * q.max()) and np.all(
+            q <= mu * analytic.circle_pressure(x, a, R, E_star) + 1e-12
+        )
+        a_h, _ = analytic.hertz_line(P, R, E_star)
+        c_h = analytic.mindlin_stick_half_width(a_h, Q, mu, P)
+        if close:
+            assert abs(c / c_h - 1) < 1e-7
+        else:
+            assert 1e-4 < 1 - c / c_h < 3 * (c / R) ** 2
