@@ -48,7 +48,8 @@ OPTIONS = [  # option, kind, default[, help]
     ("--width", "(0, inf)", None, "block width (default max(40, 40 a))"),
     ("--depth", "(0, inf)", None, "block depth (default max(20, 20 a))"),
     ("--zone", "[1, inf)", 1.2, "half-width of the zone meshed at h, in units of the Hertz a"),
-    ("--h-far", "(0, inf)", None, "mesh size far from the contact (default min(R / 2, depth / 2, 100 h))"),
+    ("--h-far", "(0, inf)", None,
+     "mesh size far from the contact (default min(R / 2, depth / 2, 100 h))"),
     ("--grading", "(0, inf)", None,
      "size growth away from the zone: slope (body-fitted, default 0.25) or ratio of "
      "neighbouring cells (cut, > 1, default 2)"),
