@@ -27,7 +27,8 @@ for n in (25, 100, 400, 1600, 6400, 25600):
         times.append(time.perf_counter() - t0)
     rows.append(dict(n=n, pairs=len(p), min_s=min(times), median_s=float(np.median(times))))
     print(
-        f"N = {n:6d}: {len(p):6d} pairs, {1e6 * min(times):9.1f} us ({1e6 * min(times) / n:.3f} us per grain)"
+        f"N = {n:6d}: {len(p):6d} pairs, {1e6 * min(times):9.1f} us "
+        f"({1e6 * min(times) / n:.3f} us per grain)"
     )
 out = Path(__file__).resolve().parent / "results"
 out.mkdir(exist_ok=True)

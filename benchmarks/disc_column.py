@@ -66,7 +66,8 @@ for k in range(a.steps):
     if comm.rank == 0:
         print(
             f"step {k + 1}: F = {F.max():.5g}, spread {np.ptp(F) / F.max():.1e}, a/h "
-            f"{min(r['a_over_h'] for r in rows[-len(F):]):.2f}..{max(r['a_over_h'] for r in rows[-len(F):]):.2f}, "
+            f"{min(r['a_over_h'] for r in rows[-len(F):]):.2f}.."
+            f"{max(r['a_over_h'] for r in rows[-len(F):]):.2f}, "
             f"max |a/aH - 1| {max(abs(r['rel_error']) for r in rows[-len(F):]):.3f}, "
             f"Newton {rec['newton_iterations']}, {rec['wall_s']:.2f} s",
             flush=True,

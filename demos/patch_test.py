@@ -8,9 +8,10 @@ sides free. The exact solution is a uniform stress: sigma_yy = -E/(1-nu^2) d/H
 (eq 8) the pressure is p = E' d / (H + E' eps_n), E' = E/(1-nu^2).
 
 The check. Linear fields are reproduced exactly, so the contact pressure must be uniform and
-equal to the penalised value (--enforcement penalty) or the exact one (augmented) to round-off, with the interface on mesh lines (conforming) or
-cutting a row of cells (--discretization cut, interface y = --interface); metrics.json reports
-the spread, the shear, and both analytic values.
+equal to the penalised value (--enforcement penalty) or the exact one (augmented) to
+round-off, with the interface on mesh lines (conforming) or cutting a row of cells
+(--discretization cut, interface y = --interface); metrics.json reports the spread, the shear,
+and both analytic values.
 
 Run: /usr/bin/python3 demos/patch_test.py [--discretization cut] [--h 0.125]
 Results and discussion: docs/demos.md#patch-test

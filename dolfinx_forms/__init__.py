@@ -26,7 +26,8 @@ try:
     from . import _cpp
 except ImportError as e:  # pragma: no cover - a clear message instead of a bare ImportError
     raise ImportError(
-        "dolfinx_forms._cpp is not built: run `make build` (or `pip install --no-build-isolation .`)"
+        "dolfinx_forms._cpp is not built: run `make build` "
+        "(or `pip install --no-build-isolation .`)"
     ) from e
 
 from ._cpp import (  # noqa: F401  (re-exported API)

@@ -115,7 +115,8 @@ def bounded(name, lo=None, hi=None, lo_open=False, hi_open=False):
     def rng():
         left = "(" if lo_open else "["
         right = ")" if hi_open else "]"
-        return f"{left}{'-inf' if lo is None else lo}, {'inf' if hi is None else hi}{')' if hi is None else right}"
+        lo_s, hi_s = ("-inf" if lo is None else lo), ("inf" if hi is None else hi)
+        return f"{left}{lo_s}, {hi_s}{')' if hi is None else right}"
 
     def convert(text):
         try:

@@ -31,11 +31,11 @@ class RigidObstacle:
 
     name: for output; shape: `_cpp.Shape` or `_cpp.LevelSet` (phi < 0 inside) in the obstacle's
     frame (a LevelSet's grid must contain the obstacle with a margin: beyond it the value is
-    extended by the distance to the grid); bbox: (2, 2) bounding box in that frame (None: the LevelSet's grid box; required for
-    a Shape); center: the point the rotation turns about (and the moment is taken about);
-    translation, rotation: the prescribed motion per step (a (2,) vector and an angle in
-    radians, counter-clockwise); bodies: tags of the deformable bodies it may touch (None:
-    all)."""
+    extended by the distance to the grid); bbox: (2, 2) bounding box in that frame (None: the
+    LevelSet's grid box; required for a Shape); center: the point the rotation turns about
+    (and the moment is taken about); translation, rotation: the prescribed motion per step (a
+    (2,) vector and an angle in radians, counter-clockwise); bodies: tags of the deformable
+    bodies it may touch (None: all)."""
 
     name: str
     shape: object

@@ -168,9 +168,10 @@ def test_zalesak_disc_one_revolution():
     """Zalesak's slotted disc rotated once about (0.5, 0.5) on 50^2 and 100^2 (252 and 503
     steps, 3 RK3 substeps each: the grid corners move 1.25 h per step; 11 and 47 calls of
     reinitialize). Relative area error 3.4e-2 and 1.1e-3 (0.96e-3 on 200^2: reinitialising at
-    the corners moves area, so the decrease is not monotone for every threshold); symmetric difference with the initial shape 9.9e-3 and 2.1e-3 (area
-    units; the shape's area is 0.058), order 2.2 (on 200^2: 4.9e-4, order 2.1; not run here,
-    13 s). The slot is 2.5 cells wide on 50^2, hence the large coarse error."""
+    the corners moves area, so the decrease is not monotone for every threshold); symmetric
+    difference with the initial shape 9.9e-3 and 2.1e-3 (area units; the shape's area is
+    0.058), order 2.2 (on 200^2: 4.9e-4, order 2.1; not run here, 13 s). The slot is 2.5 cells
+    wide on 50^2, hence the large coarse error."""
     (a1, s1, _), (a2, s2, _) = _zalesak(50), _zalesak(100)
     assert a2 < 0.01 and a2 < a1, (a1, a2)
     assert s2 < 0.004 and s1 / s2 > 3.0, (s1, s2)

@@ -67,7 +67,8 @@ def test_cut_demo_imports(tmp_path):
     r = _python(
         "import json, runpy, sys\n"
         f"runpy.run_path({str(ROOT / 'demos' / 'hertz.py')!r}, run_name='not_main')\n"
-        "print(json.dumps([m for m in ('gmsh', 'matplotlib', 'pkg_resources') if m in sys.modules]))"
+        "print(json.dumps([m for m in ('gmsh', 'matplotlib', 'pkg_resources') "
+        "if m in sys.modules]))"
     )
     assert r == []
     r = _python(
