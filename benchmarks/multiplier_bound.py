@@ -23,7 +23,6 @@ Usage: /usr/bin/python3 benchmarks/multiplier_bound.py [--out-dir benchmarks/res
 
 import argparse
 import io
-import json
 import sys
 from pathlib import Path
 
