@@ -243,23 +243,19 @@ def _augmented_loop(problem, lam, residuals, depth=20):
                 f"augmented Lagrangian: no progress in {opts.al_stall} updates, step {rho:.3g}"
             )
         first_leg = cs.mu > 0 and cs.eps_t != cs.eps_t_final
-        if first_leg and change <= max(opts.al_switch * scale, min(opts.al_rtol * scale, gap_tol)):
-            # continuation: from near this fixed point on to the one at the final eps_t
+        switch = first_leg and change <= max(
+            opts.al_switch * scale, min(opts.al_rtol * scale, gap_tol)
+        )
+        if switch:  # continuation: from near this fixed point on to the one at the final eps_t
             cs.eps_t = cs.eps_t_final
             gap_tol = opts.al_gtol * problem.scene.h_contact / max(cs.eps_n, cs.eps_t)
             X, F, best, stalled = [], [], np.inf, 0
-            early = opts.al_eta * change / max(scale, 1e-300)
-            ok, more, why = newton(problem, lam, residuals[0], early)
-            residuals += more
-            solves += 1
-            if not ok:
-                return False, solves, f"augmented Lagrangian, update {k}: {why}"
-            u_good[:], t_good = problem.u.x.array, cs.tractions()
-            continue
-        if change <= min(opts.al_rtol * scale, gap_tol):
-            if residuals[-1] <= tolerance(problem, residuals[0]):
+        if switch or change <= min(opts.al_rtol * scale, gap_tol):
+            if not switch and residuals[-1] <= tolerance(problem, residuals[0]):
                 return True, solves, ""
-            ok, more, why = newton(problem, lam, residuals[0])  # the last solve stopped early
+            # after a switch an inexact solve; else the last solve, which stopped early
+            early = opts.al_eta * change / max(scale, 1e-300) if switch else 0.0
+            ok, more, why = newton(problem, lam, residuals[0], early)
             residuals += more
             solves += 1
             if not ok:
