@@ -111,11 +111,15 @@ def contact_warnings(problem):
 
 def unheld_bodies(problem):
     """One line per body with a rigid motion that nothing holds at the committed state (module
-    doc), the same on every rank: r (x or y translation, rotation about the body's centre) on
-    the body's dofs with |J r| <= RIGID_RTOL |J| |r|, J the last tangent (Dirichlet rows kept
-    as identity rows, the contact tangent of the settled active set). All bodies' motions are
-    the columns of one sparse R and J R one product (a few nnz(J) flops: an MPM step of many
-    grains pays it per step)."""
+    doc), the same on every rank. The body's rigid motions r = R_k c (x and y translation,
+    rotation about its centre) span a 3-dimensional space; the free ones are the null space of
+    the Gram matrix G_k = (J R_k)^T (J R_k) in the metric M_k = R_k^T R_k, i.e. the c with
+    |J R_k c| <= RIGID_RTOL |J| |R_k c| (`free_rigid_modes`). J is the last tangent (Dirichlet
+    rows kept as identity rows, the contact tangent of the settled active set). A rank test,
+    not a test of each mode alone: a body touching at one sliding point is free in x and in
+    the rotation about that point, whichever of the singular system's solutions the linear
+    solver returned. All bodies' motions are the columns of one sparse R and J R one product
+    (a few nnz(J) flops: an MPM step of many grains pays it per step)."""
     from mpi4py import MPI
 
     if problem.rigid_mode_stiffness > 0:
@@ -125,12 +129,13 @@ def unheld_bodies(problem):
     X = V.tabulate_dof_coordinates()[:n_own, :2]
     dofmap = V.dofmap.list.array.reshape(-1, V.dofmap.dof_layout.num_dofs)
     bodies = problem.scene.bodies
+    nb = len(bodies)
     body = np.full(n_own, -1)  # the body of each owned node (bodies are disjoint)
     for k, b in enumerate(bodies):
         nodes = np.unique(dofmap[problem.scene.cell_tags.find(b.tag)])
         body[nodes[nodes < n_own]] = k
-    count = comm.allreduce(np.bincount(body[body >= 0], minlength=len(bodies)), op=MPI.SUM)
-    sums = np.zeros((len(bodies), 2))
+    count = comm.allreduce(np.bincount(body[body >= 0], minlength=nb), op=MPI.SUM)
+    sums = np.zeros((nb, 2))
     np.add.at(sums, body[body >= 0], X[body >= 0])
     centre = comm.allreduce(sums, op=MPI.SUM) / np.maximum(count, 1)[:, None]
     # R: a row per owned dof, the columns 3 k + (x, y, rotation) of its body k
@@ -144,19 +149,19 @@ def unheld_bodies(problem):
     cols = np.broadcast_to(cols, vals.shape).reshape(-1, 3).astype(PETSc.IntType)
     ptr = np.arange(0, 3 * n_own * bs + 1, 3, dtype=PETSc.IntType)
     R = PETSc.Mat().createAIJ(
-        ((n_own * bs, None), (None, 3 * len(bodies))),
+        ((n_own * bs, None), (None, 3 * nb)),
         csr=(ptr, cols.ravel(), vals.reshape(-1, 3).ravel()),
         comm=comm,
     )
-    _, yj, yv = J.matMult(R).getValuesCSR()  # this rank's rows, global columns
-    Jr2 = comm.allreduce(np.bincount(yj, yv**2, 3 * len(bodies)), op=MPI.SUM)
-    r2 = comm.allreduce(np.bincount(cols.ravel(), vals.ravel() ** 2, 3 * len(bodies)), MPI.SUM)
+    JR = J.matMult(R)
+    A = reduce_rfactors(comm, body_rfactors(*JR.getValuesCSR(), nb))
+    B = reduce_rfactors(comm, body_rfactors(ptr, cols.ravel(), vals.reshape(-1, 3).ravel(), nb))
+    JR.destroy()
     R.destroy()
     norm = J.norm(PETSc.NormType.INFINITY)
-    free = (r2 > 0) & (np.sqrt(Jr2) <= RIGID_RTOL * norm * np.sqrt(r2))
     out = []
     for k, b in enumerate(bodies):
-        names = [n for m, n in enumerate(("x", "y", "rotation")) if free[3 * k + m]]
+        names = free_rigid_modes(A[k], B[k], norm, centre[k])
         if names:
             out.append(
                 f"{b.name}: held by nothing in {', '.join(names)} (no Dirichlet condition or "
@@ -164,6 +169,89 @@ def unheld_bodies(problem):
                 "solutions (hold it, or close its contacts)"
             )
     return out
+
+
+def body_rfactors(ptr, cols, vals, num_bodies):
+    """The triangular factors T_k (3 x 3) with T_k^T T_k = A_k^T A_k, A_k the columns 3 k ...
+    3 k + 2 of a CSR matrix A (this rank's rows; column 3 k + m: body k, rigid mode m): a QR
+    of each body's rows. |A_k c| = |T_k c| without squaring A's condition number (a Gram
+    matrix would bury round-off-sized singular values, the free modes, under its round-off).
+    Shape (num_bodies, 3, 3)."""
+    row = np.repeat(np.arange(len(ptr) - 1), np.diff(ptr))
+    key, inv = np.unique(row * num_bodies + cols // 3, return_inverse=True)
+    dense = np.zeros((len(key), 3))
+    np.add.at(dense, (inv.ravel(), cols % 3), vals)
+    return stacked_rfactors(dense, key % num_bodies, num_bodies)
+
+
+def stacked_rfactors(rows, body, num_bodies):
+    """T_k of the rows (n, 3) of each body k = body[i] (one QR per body: a loop over bodies,
+    not points)."""
+    out = np.zeros((num_bodies, 3, 3))
+    order = np.argsort(body, kind="stable")
+    bounds = np.searchsorted(body[order], np.arange(num_bodies + 1))
+    for k in range(num_bodies):
+        block = rows[order[bounds[k] : bounds[k + 1]]]
+        if len(block):
+            r = np.linalg.qr(block, mode="r")
+            out[k, : r.shape[0]] = r
+    return out
+
+
+def reduce_rfactors(comm, T):
+    """The T_k of all ranks' rows from each rank's T_k: a QR of the stacked factors."""
+    parts = comm.allgather(T)
+    if len(parts) == 1:
+        return T
+    nb = T.shape[0]
+    rows = np.concatenate([p.reshape(-1, 3) for p in parts])
+    return stacked_rfactors(rows, np.tile(np.repeat(np.arange(nb), 3), len(parts)), nb)
+
+
+def free_rigid_modes(A, B, norm, centre):
+    """Names of the rigid motions c (x, y translation, rotation about `centre`) of one body
+    with |J R c| <= RIGID_RTOL norm |R c|, from triangular factors with |J R c| = |A c| and
+    |R c| = |B c| (`body_rfactors`). A basis of that null space, named without depending on
+    which basis the SVD returns: the free translations ("x", "y", or a direction), then the
+    free rotation, if any, by its centre (the point that rotation leaves still)."""
+    if abs(np.linalg.det(B)) <= 1e-300:
+        return []  # no dof of the body anywhere: nothing to say
+    # c = B^-1 w whitens the modes: the singular values of A B^-1 are |J r| / |r|
+    Bi = np.linalg.inv(B)
+    _, sigma, Wt = np.linalg.svd(A @ Bi)
+    N = Bi @ Wt[sigma <= RIGID_RTOL * norm].T  # the free c, columns
+    d = N.shape[1]
+    if d == 0:
+        return []
+    if d == 3:
+        return ["x", "y", "rotation"]
+    # translations in span(N): its vectors with no rotation component
+    rot = N[2] / max(np.abs(N).max(), 1e-300)
+    if np.all(np.abs(rot) <= 1e-6):
+        T, c_rot = N[:2], None
+    else:
+        # move the rotation into one basis vector, the others then translate only
+        j = int(np.argmax(np.abs(N[2])))
+        c_rot = N[:, j] / N[2, j]
+        T = np.delete(N - np.outer(c_rot, N[2]), j, axis=1)[:2]
+    names = []
+    if T.shape[1] == 2:
+        names += ["x", "y"]
+    elif T.shape[1] == 1:
+        t = T[:, 0] / np.linalg.norm(T[:, 0])
+        names.append(
+            "x"
+            if abs(t[1]) <= 1e-6
+            else "y" if abs(t[0]) <= 1e-6 else f"the translation along ({t[0]:.3g}, {t[1]:.3g})"
+        )
+    if c_rot is not None:
+        if T.shape[1] == 1:  # the rotation's centre is set up to the free translation
+            t = T[:, 0] / np.linalg.norm(T[:, 0])
+            c_rot[:2] -= (c_rot[:2] @ t) * t
+        # the motion (a - w dy, b + w dx) with w = 1 vanishes at centre + (-b, a)
+        x0 = centre + np.array([-c_rot[1], c_rot[0]])
+        names.append(f"the rotation about ({x0[0]:.4g}, {x0[1]:.4g})")
+    return names
 
 
 def penetration(problem):
