@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The iterative linear solver (CG + GAMG with the rigid-body modes, dolfinx_forms.linear.
+"""The iterative linear solver (CG + GAMG with the rigid-body modes, dolfinx_forms.solvers.linear.
 Iterative) against the direct ones on Hertz, and its iteration counts against the smallest cut
 fraction (issue 12, item 5).
 
@@ -43,9 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
-from scaling import _hertz_demo, child, write_atomic  # the script's folder is on sys.path
-from work_precision import git_head
-from work_precision import write_atomic as replace_atomic
+from benchmarks.common import child, git_head, hertz_demo, write_atomic, write_text
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -74,9 +72,9 @@ SETUPS = {"tuned": None, "petsc": PETSC_GAMG, "hypre": HYPRE}
 # --------------------------------------------------------------------------- hertz
 def hertz_child(path, divisor, solver, npy):
     """One Hertz run in this process; prints a JSON record, saves u to npy."""
-    from dolfinx_forms.demo import compute
+    from dolfinx_forms.app.demo import compute
 
-    hertz = _hertz_demo()
+    hertz = hertz_demo()
     kinds = {"direct": ["condensed", "factorised"], "hypre": ["iterative"]}.get(solver, [solver])
     for kind in kinds:
         p = vars(hertz.parse(["--discretization", path, "--linear-solver", kind]))
@@ -160,7 +158,7 @@ def hertz_table(runs, timeout, tmp):
 def cuts_table(n, etas, gammas, eps0s):
     from small_cuts import interface_height, patch_problem
 
-    from dolfinx_forms.newton import ContactSolverError
+    from dolfinx_forms.solvers.newton import ContactSolverError
 
     rows = []
     for eps0 in eps0s:
@@ -197,7 +195,7 @@ def cuts_table(n, etas, gammas, eps0s):
 
 def _patch(patch_problem, n, interface, gamma, eps0, petsc_options):
     """small_cuts.patch_problem with the iterative solver (and petsc_options)."""
-    from dolfinx_forms import solver
+    from dolfinx_forms.solvers import problem as solver
 
     orig = solver.ContactProblem
 
@@ -223,10 +221,10 @@ def bodies_table(divisors, gradings=(None, 1.2)):
     from dolfinx import la
     from petsc4py import PETSc
 
-    from dolfinx_forms import linear
-    from dolfinx_forms.demo import compute
+    from dolfinx_forms.app.demo import compute
+    from dolfinx_forms.solvers import linear
 
-    hertz = _hertz_demo()
+    hertz = hertz_demo()
     rows = []
     for d in divisors:
         for grading in gradings:
@@ -291,7 +289,7 @@ def write_csv(rows, path):
     w = csv.DictWriter(buf, fieldnames=keys, extrasaction="ignore")
     w.writeheader()
     w.writerows(rows)
-    write_atomic(path, buf.getvalue())
+    write_text(path, buf.getvalue())
 
 
 def plot(hertz, cuts, path):
@@ -339,7 +337,7 @@ def plot(hertz, cuts, path):
     for a in ax:
         a.grid(True, which="both", lw=0.3)
     fig.tight_layout()
-    replace_atomic(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
+    write_atomic(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
 
 
 def main(argv=None):
@@ -402,7 +400,7 @@ def main(argv=None):
         cuts=cuts,
         bodies=bodies,
     )
-    write_atomic(out / "amg.json", json.dumps(tables, indent=1))
+    write_text(out / "amg.json", json.dumps(tables, indent=1))
     write_csv(bodies, out / "amg_bodies.csv")
     write_csv(hertz, out / "amg_hertz.csv")
     write_csv(cuts, out / "amg_cuts.csv")

@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_forms.boundary import Dirichlet
-from dolfinx_forms.mpm import ImplicitMPM, MPMBody
+from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
 from meshes.mpm import disc_column
 
 ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])

@@ -2,7 +2,7 @@
 """GetFEM's nodal P1 contact on the Hertz line contact of demos/hertz.py: the same scene, load
 and p(x) error measure, the reference of benchmarks/work_precision.py's time-to-accuracy ratios.
 
-Problem (demos/hertz.py defaults, dolfinx_forms/study.py CASE): a half-cylinder R = 10 mm (flat
+Problem (demos/hertz.py defaults, dolfinx_forms/app/study.py CASE): a half-cylinder R = 10 mm (flat
 face on top) on a block [-20, 20] x [-20, 0] clamped at its bottom, both E = 1e4, nu = 0.3,
 linear elasticity in plane strain, frictionless, line load P = 430 N/mm; Hertz:
 E* = E / (2 (1 - nu^2)), a = sqrt(4 P R / (pi E*)) = 0.998 mm, p(x) = p0 sqrt(1 - x^2/a^2).
@@ -38,7 +38,7 @@ first tangent is singular: no active node holds the cylinder); with that active 
 converges in 1-2 iterations. GetFEM's default linear solver (sequential MUMPS, LU: the model is
 not symmetric) and line search; residual 1e-9.
 
-Error measure, the definition of dolfinx_forms/compare.py: p(x) relative L2 error
+Error measure, the definition of dolfinx_forms/analysis/compare.py: p(x) relative L2 error
 sqrt(int (p - p_H)^2 / int p_H^2) along the slave surface against Hertz *at the computed load*
 (P_c = the sum of the nodal contact forces, P to the solver tolerance), with the quadrature of
 our demo (--gauss 2): 2 Gauss points per slave segment, at their reference x. The nodal forces
@@ -48,8 +48,8 @@ sum over the slave nodes with their tributary lengths as weights (the nodal meth
 points); it scatters more between neighbouring h (0.4 ... 1.7 % over a/12 ... a/34), since the
 last active node's lumped pressure depends on where it falls near the edge. a: half the
 distance between the zone ends, each the midpoint between the last active and the first
-inactive slave node (the fallback of dolfinx_forms.solver.zone_ends: with exact multipliers an
-active node's gap is 0, there is no sign change to interpolate); p0: the largest p_i.
+inactive slave node (the fallback of dolfinx_forms.solvers.problem.zone_ends: with exact multipliers
+an active node's gap is 0, there is no sign change to interpolate); p0: the largest p_i.
 
 Times: in-process wall times (perf_counter), without interpreter start-up and imports: mesh
 (gmsh and the GetFEM meshes), setup (FEM spaces, regions, bricks, initial guess), solve
@@ -93,7 +93,8 @@ def mesh_bodies(h, zone, h_far, growth):
     """gmsh P1 triangles of the cylinder and of the block: [(points 2 x n, triangles 3 x m)] in
     that order; target FAC h on |x|, |y| <= zone, growing with slope `growth` up to h_far. The
     two bodies have separate vertices at the origin (no shared node)."""
-    from meshes.scene import gmsh_model  # quiet, sizes from the field only; cleaned up after
+    # quiet, sizes from the field only; cleaned up after
+    from dolfinx_forms.mesh.scene import gmsh_model
 
     # comm None: no MPI (a GetFEM user's process initialises none; MPI_Init costs 0.1-0.4 s)
     with gmsh_model(None, "getfem_hertz") as gmsh:
@@ -247,7 +248,7 @@ def pressure_errors(x, y, force, gauss=GAUSS):
     def p_hertz(xs):
         return p0_H * np.sqrt(np.clip(1 - (xs / a_H) ** 2, 0.0, None))
 
-    def rel_l2(w, pc, ph):  # dolfinx_forms.compare.rel_l2
+    def rel_l2(w, pc, ph):  # dolfinx_forms.analysis.compare.rel_l2
         return float(np.sqrt(np.sum(w * (pc - ph) ** 2) / np.sum(w * ph**2)))
 
     s, gw = np.polynomial.legendre.leggauss(gauss)

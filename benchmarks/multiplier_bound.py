@@ -140,10 +140,7 @@ def main(argv=None):
             f"P{r['degree']}      {r['node_spacing_h']:5.2f}           "
             f"{100 * r['min']:.2f} .. {100 * r['max']:.2f} %"
         )
-    if __package__:
-        from .work_precision import write_atomic, write_json
-    else:
-        from work_precision import write_atomic, write_json
+    from benchmarks.common import write_atomic, write_json
 
     write_json(a.out_dir / "multiplier_bound.json", dict(divisor=a.divisor, rows=rows))
     png = plot(rows, a.divisor, None)

@@ -44,18 +44,16 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_forms.cli import DemoParser, bounded
-from dolfinx_forms.laws import LinearElastic, OrthotropicElastic
-from dolfinx_forms.output import gather_points, window_average
-from dolfinx_forms.protocol import ramp
-from dolfinx_forms.solver import ContactProblem, Dirichlet, zone_ends
+from benchmarks.common import git_head, write_atomic
+from dolfinx_forms.app.cli import DemoParser, bounded
+from dolfinx_forms.fem.laws import LinearElastic, OrthotropicElastic
+from dolfinx_forms.io.output import gather_points, window_average
+from dolfinx_forms.solvers.problem import ContactProblem, zone_ends
+from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.solvers.protocol import ramp
 from meshes.cut import hertz_cut_scene
 from meshes.hertz import ellipse_sag, hertz_scene
 
-if __package__:  # imported as benchmarks.orthotropic_paths (tests)
-    from .work_precision import git_head, write_atomic
-else:  # run as a script: benchmarks/ is sys.path[0]
-    from work_precision import git_head, write_atomic
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -22,51 +22,15 @@ import argparse
 import csv
 import io
 import json
-import os
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
+from benchmarks.common import child, hertz_demo, write_atomic, write_text
+
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-# runs a script and prints its peak resident memory (kB) as the last line of stderr
-WRAP = (
-    "import resource, runpy, sys; script = sys.argv[1]; sys.argv = sys.argv[1:]\n"
-    "try:\n    runpy.run_path(script, run_name='__main__')\n"
-    "except SystemExit as e:\n    code = e.code\nelse:\n    code = 0\n"
-    "print('peak_rss_kb', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)\n"
-    "sys.exit(code)"
-)
-
-
-def child(cmd, timeout):
-    """Run the script cmd[0] with arguments cmd[1:]; returns (returncode, stdout, stderr, wall
-    seconds, peak RSS in MB)."""
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(
-        [sys.executable, "-c", WRAP, *cmd],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=env,
-        cwd=ROOT,
-    )
-    try:
-        out, err = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        out, err = proc.communicate()
-        return -9, out, f"timeout after {timeout} s", time.perf_counter() - t0, 0.0
-    wall = time.perf_counter() - t0
-    lines = [x for x in err.splitlines() if x.startswith("peak_rss_kb ")]
-    rss = int(lines[-1].split()[1]) / 1024 if lines else 0.0
-    err = "\n".join(x for x in err.splitlines() if not x.startswith("peak_rss_kb "))
-    return proc.returncode, out, err, wall, rss
 
 
 def measure(discretization, divisor, timeout, tmp):
@@ -110,9 +74,9 @@ def measure(discretization, divisor, timeout, tmp):
 def reference_main(discretization, divisor):
     from mpi4py import MPI
 
-    from dolfinx_forms.results import PhaseTimer, new_metrics
+    from dolfinx_forms.io.results import PhaseTimer, new_metrics
 
-    hertz = _hertz_demo()
+    hertz = hertz_demo()
 
     metrics = new_metrics("reference", discretization, {})
     timer = PhaseTimer(metrics)
@@ -130,9 +94,10 @@ def _reference_timed(discretization, divisor, timer):
     from mpi4py import MPI
     from petsc4py import PETSc
 
-    from dolfinx_forms.solver import ContactProblem, Dirichlet
+    from dolfinx_forms.solvers.problem import ContactProblem
+    from dolfinx_forms.fem.boundary import Dirichlet
 
-    hertz = _hertz_demo()
+    hertz = hertz_demo()
     p = vars(hertz.parse(["--discretization", discretization]))
     p["h"] = hertz.estimate(p)[1] / divisor
     run = type("Run", (), {"params": p, "comm": MPI.COMM_WORLD})()
@@ -163,31 +128,6 @@ def _reference_timed(discretization, divisor, timer):
     )
 
 
-def _hertz_demo():
-    """demos/hertz.py as a module (its parse, estimate and scene), without editing sys.path."""
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("hertz_demo", ROOT / "demos" / "hertz.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def replace_atomic(path, write):
-    """work_precision.write_atomic, imported here: the script's folder is on sys.path when it
-    runs as the benchmark, not in its children (the demo and the reference run through WRAP,
-    runpy), which never write results."""
-    from work_precision import write_atomic as replace
-
-    replace(path, write)
-
-
-def write_atomic(path, text):
-    """`text` into `path` in one rename (work_precision.write_atomic)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    replace_atomic(path, lambda tmp: Path(tmp).write_text(text))
-
-
 def plot(rows, path):
     import matplotlib
 
@@ -215,7 +155,7 @@ def plot(rows, path):
         a.legend(fontsize=8)
         a.grid(True, which="both", lw=0.3)
     fig.tight_layout()
-    replace_atomic(path, lambda tmp: fig.savefig(tmp, dpi=120, format="png"))
+    write_atomic(path, lambda tmp: fig.savefig(tmp, dpi=120, format="png"))
 
 
 def main(argv=None):
@@ -236,13 +176,13 @@ def main(argv=None):
                 rows.append(r)
                 print(json.dumps(r), flush=True)
     out = Path(args.out_dir)
-    write_atomic(out / "scaling.json", json.dumps(rows, indent=1))
+    write_text(out / "scaling.json", json.dumps(rows, indent=1))
     keys = list(dict.fromkeys(k for r in rows for k in r))
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=keys)
     w.writeheader()
     w.writerows(rows)
-    write_atomic(out / "scaling.csv", buf.getvalue())
+    write_text(out / "scaling.csv", buf.getvalue())
     plot(rows, out / "scaling.png")
     print(f"results in {out}/scaling.{{json,csv,png}}")
     return 0

@@ -48,16 +48,14 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from dolfinx_forms import analytic
-from dolfinx_forms.cli import DemoParser, bounded
-from dolfinx_forms.solver import ContactProblem, ContactSolverError
+from dolfinx_forms.analysis import analytic
+from benchmarks.common import git_head, write_atomic
+from dolfinx_forms.app.cli import DemoParser, bounded
+from dolfinx_forms.solvers.problem import ContactProblem
+from dolfinx_forms.solvers.newton import ContactSolverError
 from meshes.cut import patch_cut_scene
 from meshes.patch import patch_dirichlet
 
-if __package__:  # imported as benchmarks.small_cuts (tests)
-    from .work_precision import git_head, write_atomic
-else:  # run as a script: benchmarks/ is sys.path[0]
-    from work_precision import git_head, write_atomic
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -38,6 +38,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from benchmarks.common import write_atomic
+
 ROOT = Path(__file__).resolve().parents[1]
 PYTHON = "/usr/bin/python3"  # Debian's interpreter: it has dolfinx, gmsh and getfem
 
@@ -101,15 +103,14 @@ def summarise(runs, names):
     return out, ratios
 
 
-def write_atomic(path, write):
-    """write(binary file object) into `path` in one rename (work_precision.write_atomic)."""
-    from work_precision import write_atomic as replace_atomic
+def write_binary(path, write):
+    """write(binary file object) into `path` in one rename (common.write_atomic)."""
 
     def writer(tmp):
         with open(tmp, "wb") as f:
             write(f)
 
-    replace_atomic(path, writer)
+    write_atomic(path, writer)
 
 
 def plot(path, summary, ratios, n):
@@ -140,7 +141,7 @@ def plot(path, summary, ratios, n):
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110)
     plt.close(fig)
-    write_atomic(path, lambda f: f.write(buf.getvalue()))
+    write_binary(path, lambda f: f.write(buf.getvalue()))
 
 
 def main(argv=None):

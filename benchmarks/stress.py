@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from dolfinx_forms.checks import short_gaps
+from dolfinx_forms.solvers.checks import short_gaps
 
 ROOT = Path(__file__).resolve().parents[1]
 EXACT_PATCH = 0.01 / (1 - 0.3**2)

@@ -11,7 +11,7 @@ level sets on a graded structured grid, Q1, hertz.py's default ghost penalty), e
 default penalty; p1-tri-al and q1-cut-al the same with --enforcement augmented (P1
 multipliers, point-wise traction, --multiplier-mass lumped: the closest pressure); q1-cut-al-z1
 is q1-cut-al with the fine zone just covering the contact (--zone 1.0, see
-dolfinx_forms/study.py); p1-tri-layers the body-fitted P1 triangles meshed without gmsh
+dolfinx_forms/app/study.py); p1-tri-layers the body-fitted P1 triangles meshed without gmsh
 (--mesher layers: meshes/layers.py) with --zone 1.0 --grading 0.5. Default p1-tri,p1-quad,
 q1-cut,p1-tri-al,q1-cut-al,q1-cut-al-z1,p1-tri-layers, so one run compares both paths, both
 enforcements and both meshers.
@@ -75,7 +75,6 @@ Usage: /usr/bin/python3 benchmarks/work_precision.py [--quick] [--variants p1-tr
 """
 
 import hashlib
-import importlib.util
 import json
 import math
 import os
@@ -87,26 +86,17 @@ from pathlib import Path
 
 import numpy as np
 
-from dolfinx_forms.cli import DemoParser
-from dolfinx_forms.study import last_line
+from benchmarks.common import git_head, load_script, write_atomic, write_json
+from dolfinx_forms.app.cli import DemoParser
+from dolfinx_forms.app import study
+from dolfinx_forms.app.study import last_line
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _load_study():
-    """demos/convergence_study.py as a module (demos/ is not a package): run_hertz and the
-    variants live there, once."""
-    name = "convergence_study"
-    if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(name, ROOT / "demos" / f"{name}.py")
-        mod = importlib.util.module_from_spec(spec)
-        sys.modules[name] = mod
-        spec.loader.exec_module(mod)
-    return sys.modules[name]
-
-
-study = _load_study()
-DEMO = study.HERTZ
+# demos/convergence_study.py: the Hertz runner (run_hertz, HERTZ), shared, once
+demo = load_script(ROOT / "demos" / "convergence_study.py")
+DEMO = demo.HERTZ
 HERTZ_DEFAULTS = study.CASE  # passed explicitly to every run
 VARIANTS = study.VARIANTS  # name -> extra demo arguments
 ERRORS, PHASES = study.ERRORS, study.PHASES
@@ -222,7 +212,7 @@ def code_digest():
     others may edit the repository while the benchmark runs; a change shows up per run."""
     files = [
         DEMO,
-        Path(study.__file__),
+        Path(demo.__file__),
         *sorted((ROOT / "dolfinx_forms").glob("*.py")),
         *sorted((ROOT / "dolfinx_forms").glob("_cpp*.so")),
         *sorted((ROOT / "meshes").glob("*.py")),
@@ -232,26 +222,6 @@ def code_digest():
         h.update(str(f.relative_to(ROOT)).encode())
         h.update(f.read_bytes())
     return h.hexdigest()[:12]
-
-
-def git_head():
-    try:
-        r = subprocess.run(
-            ["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True, timeout=30
-        )
-        d = subprocess.run(
-            ["git", "status", "--porcelain", "--untracked-files=no"],
-            cwd=ROOT,
-            capture_output=True,
-            text=True,
-            timeout=30,
-        )
-        return dict(
-            commit=r.stdout.strip() or None,
-            modified=[ln[3:] for ln in d.stdout.splitlines() if ln.strip()],
-        )
-    except (OSError, subprocess.SubprocessError):
-        return dict(commit=None, modified=None)
 
 
 def hertz_half_width():
@@ -268,7 +238,7 @@ def run_one(variant, divisor, h, timeout):
         code_sha256=code_digest(),
     )
     with tempfile.TemporaryDirectory(prefix="work_precision_keep.") as keep:
-        rec.update(study.run_hertz(h, VARIANTS[variant], timeout, keep=keep))
+        rec.update(demo.run_hertz(h, VARIANTS[variant], timeout, keep=keep))
         if rec.get("ok"):
             rec["_profile"] = read_profile(Path(keep) / "tractions.csv")
     return rec
@@ -540,34 +510,6 @@ def compare_paths(summary):
     )
 
 
-def write_atomic(path, writer):
-    """writer(tmp_path) writes the file; it then replaces `path` in one rename."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        writer(tmp)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the usual file mode
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
-def write_json(path, data):
-    def writer(tmp):
-        with open(tmp, "w") as f:
-            json.dump(data, f, indent=2, allow_nan=False)
-            f.write("\n")
-            f.flush()
-            os.fsync(f.fileno())
-
-    write_atomic(path, writer)
-
-
 COLORS = {
     "p1-tri": "tab:blue",
     "p2-tri": "tab:orange",
@@ -749,7 +691,7 @@ def getfem_data(data, getfem_runs, divisors, vs):
         cpu_count=data["cpu_count"],
         definitions=dict(
             error="p(x) relative L2 error against Hertz at the computed load, both sides "
-            "(dolfinx_forms/compare.py; GetFEM: the P1 interpolant of its lumped nodal "
+            "(dolfinx_forms/analysis/compare.py; GetFEM: the P1 interpolant of its lumped nodal "
             "pressures at 2 Gauss points per slave segment, see benchmarks/getfem_hertz.py)",
             time="in-process total: ours the demo's timing_s.total, GetFEM mesh + setup + "
             "solve + post; neither counts interpreter start-up nor imports (wall_s: the "

@@ -14,17 +14,17 @@ a > 5 h; the forces on the two platens equal (the disc is free: equilibrium); th
 area against the material points' volume; the mass of the points constant.
 
 Run: /usr/bin/python3 demos/brazilian_disc.py [--steps 50] [--h 0.2]
-Results and discussion: docs/demos.md#brazilian-disc
+Results and discussion: docs/demos/brazilian_disc.md
 """
 
 import sys
 
 import numpy as np
 
-from dolfinx_forms import cli
-from dolfinx_forms.boundary import Dirichlet
-from dolfinx_forms.mpm import ImplicitMPM, MPMBody
-from dolfinx_forms.mpm_output import binned_mean, run_steps
+from dolfinx_forms.app import cli
+from dolfinx_forms.app.mpm_run import binned_mean, run_steps
+from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
 from meshes.mpm import brazilian_disc
 
 # fmt: off

@@ -12,7 +12,7 @@ The check. The demo builds Gamma_c, projects its quadrature points onto both bod
 and reports the errors of position and gap against these formulas.
 
 Run: /usr/bin/python3 demos/contact_geometry.py [--R 10 --gap 0.02 --h 0.05 --out DIR]
-Results and discussion: docs/demos.md#contact-geometry
+Results and discussion: docs/demos/contact_geometry.md
 """
 
 import csv
@@ -21,9 +21,9 @@ from types import SimpleNamespace
 import numpy as np
 
 import dolfinx_forms as df
-from dolfinx_forms import cli
-from dolfinx_forms.demo import run_case
-from dolfinx_forms.newton import ContactSolverError
+from dolfinx_forms.app import cli
+from dolfinx_forms.app.demo import run_case
+from dolfinx_forms.solvers.newton import ContactSolverError
 
 OPTIONS = [  # option, kind, default[, help]
     ("--R", "(0, inf)", 10.0, "radius (mm)"),

@@ -16,16 +16,16 @@ contacts slip (the paper: "an obvious shift between two stress concentration reg
 slipping"): the stick fraction of every contact's active zone.
 
 Run: /usr/bin/python3 demos/four_grains.py [--h 0.1] [--mu 0.5] [--steps 1]
-Results and discussion: docs/demos.md#four-grains
+Results and discussion: docs/demos/four_grains.md
 """
 
 import sys
 
 import numpy as np
 
-from dolfinx_forms import cli
-from dolfinx_forms.mpm import ImplicitMPM, MPMBody, equilibrium_error
-from dolfinx_forms.mpm_output import binned_mean, plot_force_chains, run_steps
+from dolfinx_forms.app import cli
+from dolfinx_forms.app.mpm_run import binned_mean, plot_force_chains, run_steps
+from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody, equilibrium_error
 from meshes.four_grains import check_contact_zones, four_grains, grain_outlines
 from meshes.mpm import plate_face_conditions
 

@@ -15,16 +15,16 @@ largest contact force), the plates' forces in balance; the normal and tangential
 plates per step (steps.csv), the force chains at the end of each phase.
 
 Run: /usr/bin/python3 demos/grain_assembly.py [--grains 15] [--friction-angle 30]
-Results and discussion: docs/demos.md#disc-column-and-assemblies
+Results and discussion: docs/demos/grain_assembly.md
 """
 
 import sys
 
 import numpy as np
 
-from dolfinx_forms import cli
-from dolfinx_forms.mpm import ImplicitMPM, MPMBody, equilibrium_error
-from dolfinx_forms.mpm_output import plot_force_chains, run_steps
+from dolfinx_forms.app import cli
+from dolfinx_forms.app.mpm_run import plot_force_chains, run_steps
+from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody, equilibrium_error
 from meshes.assembly import grain_assembly
 
 # fmt: off

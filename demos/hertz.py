@@ -17,15 +17,16 @@ to 0.4 % at the default a/R = 0.1.
 
 Run: /usr/bin/python3 demos/hertz.py [--discretization cut] [--mu 0.3 --tangential 0.5]
      [--mesher layers] (body-fitted triangles without gmsh: meshes/layers.py)
-Results and discussion: docs/demos.md#hertz-and-cattaneo-mindlin
+Results and discussion: docs/demos/hertz.md
 """
 
 import sys
 
-from dolfinx_forms import analytic, cli, compare
-from dolfinx_forms.demo import run_case
-from dolfinx_forms.protocol import friction_on, reach_force
-from dolfinx_forms.solver import Dirichlet
+from dolfinx_forms.analysis import analytic, compare
+from dolfinx_forms.app import cli
+from dolfinx_forms.app.demo import run_case
+from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.solvers.protocol import friction_on, reach_force
 from meshes.cut import hertz_cut_scene
 from meshes.hertz import MESHERS, hertz_scene, mesh_size_bounds
 

@@ -20,19 +20,20 @@ slipping points and |tau_t|/p_n; sticking under the uniaxial supports, the relat
 of p_n and tau_t against the uniform state. Default mu = 0.19: the slipping case.
 
 Run: /usr/bin/python3 demos/inclined_interface.py [--mu 0.21] [--discretization cut]
-Results and discussion: docs/demos.md#inclined-interface
+Results and discussion: docs/demos/inclined_interface.md
 """
 
 import sys
 
 import numpy as np
 
-from dolfinx_forms import analytic, cli, compare, post
-from dolfinx_forms.boundary import nearest_vertex_marker
-from dolfinx_forms.demo import run_case
-from dolfinx_forms.output import plot_lines
-from dolfinx_forms.protocol import friction_on, ramp
-from dolfinx_forms.solver import Dirichlet
+from dolfinx_forms.analysis import analytic, compare, post
+from dolfinx_forms.app import cli
+from dolfinx_forms.app.demo import run_case
+from dolfinx_forms.fem.boundary import nearest_vertex_marker
+from dolfinx_forms.io.output import plot_lines
+from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.solvers.protocol import friction_on, ramp
 from meshes.cut import cut_counts, incline_cut_scene
 from meshes.incline import incline_scene
 

@@ -15,16 +15,16 @@ every body is in equilibrium (resultant of its contact forces, plates: plus supp
 iterations per step (the paper: 4).
 
 Run: /usr/bin/python3 demos/nine_discs.py [--h 0.1] [--mu 0.5]
-Results and discussion: docs/demos.md#nine-discs
+Results and discussion: docs/demos/nine_discs.md
 """
 
 import sys
 
 import numpy as np
 
-from dolfinx_forms import cli
-from dolfinx_forms.mpm import ImplicitMPM, MPMBody, equilibrium_error
-from dolfinx_forms.mpm_output import plot_force_chains, run_steps
+from dolfinx_forms.app import cli
+from dolfinx_forms.app.mpm_run import plot_force_chains, run_steps
+from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody, equilibrium_error
 from meshes.mpm import nine_discs, plate_face_conditions
 
 # fmt: off

@@ -14,16 +14,17 @@ round-off, with the interface on mesh lines (conforming) or cutting a row of cel
 and both analytic values.
 
 Run: /usr/bin/python3 demos/patch_test.py [--discretization cut] [--h 0.125]
-Results and discussion: docs/demos.md#patch-test
+Results and discussion: docs/demos/patch_test.md
 """
 
 import sys
 
 import numpy as np
 
-from dolfinx_forms import cli, compare
-from dolfinx_forms.demo import run_case
-from dolfinx_forms.protocol import ramp
+from dolfinx_forms.analysis import compare
+from dolfinx_forms.app import cli
+from dolfinx_forms.app.demo import run_case
+from dolfinx_forms.solvers.protocol import ramp
 from meshes.cut import patch_cut_scene
 from meshes.patch import patch_dirichlet, patch_scene
 

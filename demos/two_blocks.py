@@ -21,7 +21,7 @@ max |p_t|/p_n (the friction coefficient below which slip starts) and sigma_x alo
 (sigma_x_line.csv). At mu = 1.0 the interface does not slip; try --mu 0.5.
 
 Run: /usr/bin/python3 demos/two_blocks.py [--mu 0.5] [--discretization cut] [--h 0.2]
-Results and discussion: docs/demos.md#two-blocks
+Results and discussion: docs/demos/two_blocks.md
 """
 
 import sys
@@ -29,11 +29,12 @@ import sys
 import numpy as np
 import ufl
 
-from dolfinx_forms import cli, compare, post
-from dolfinx_forms.demo import run_case
-from dolfinx_forms.output import write_columns
-from dolfinx_forms.protocol import friction_on, ramp
-from dolfinx_forms.solver import Dirichlet, Traction
+from dolfinx_forms.analysis import compare, post
+from dolfinx_forms.app import cli
+from dolfinx_forms.app.demo import run_case
+from dolfinx_forms.io.output import write_columns
+from dolfinx_forms.fem.boundary import Dirichlet, Traction
+from dolfinx_forms.solvers.protocol import friction_on, ramp
 from meshes.cut import cut_counts, two_blocks_cut_scene
 from meshes.two_blocks import two_blocks_scene
 

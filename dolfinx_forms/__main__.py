@@ -1,4 +1,4 @@
-"""Command line: run or check a scene description (see dolfinx_forms/scene_spec.py).
+"""Command line: run or check a scene description (see dolfinx_forms/app/scene_spec.py).
 
     python3 -m dolfinx_forms run SCENE.toml [--out DIR] [--force] [--set KEY=VALUE ...]
     python3 -m dolfinx_forms check SCENE.toml [--set KEY=VALUE ...]
@@ -11,9 +11,9 @@ written); 2 a bad description, option or --out (one line naming the key, nothing
 
 import sys
 
-from .cli import DemoParser, exit_process
-from .folders import OutputFolderError
-from .scene_spec import SpecError
+from dolfinx_forms.app.cli import DemoParser, exit_process
+from dolfinx_forms.app.scene_spec import SpecError
+from dolfinx_forms.io.folders import OutputFolderError
 
 PROG = "python3 -m dolfinx_forms"
 
@@ -52,7 +52,7 @@ def main(argv=None):
     rank0 = MPI.COMM_WORLD.rank == 0
     try:
         if args.command == "check":
-            from .scene_spec import load
+            from dolfinx_forms.app.scene_spec import load
 
             spec = load(args.scene, args.set)
             if rank0:
@@ -61,8 +61,8 @@ def main(argv=None):
                     f"{len(spec['stages'])} stages, {len(spec['checks'])} checks: ok"
                 )
             return 0
-        from .newton import ContactSolverError
-        from .app import run
+        from dolfinx_forms.app import run
+        from dolfinx_forms.solvers.newton import ContactSolverError
 
         try:
             result = run(

@@ -8,7 +8,7 @@ gmsh runs on rank 0 only; call the generators collectively on `comm`:
     from meshes import hertz_scene, two_blocks_scene, incline_scene, patch_scene
 """
 
-from .scene import (  # noqa: F401
+from dolfinx_forms.mesh.scene import (  # noqa: F401
     Body,
     Scene,
     gmsh_model,

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 import dolfinx_forms as df
-from dolfinx_forms.obstacles import RigidObstacle
+from dolfinx_forms.geometry.obstacles import RigidObstacle
 
-from .cut import half_plane
+from dolfinx_forms.mesh.cut_scene import half_plane
 from .mpm import grid_scene, uniform_lines
 
 

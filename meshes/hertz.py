@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .scene import (
+from dolfinx_forms.mesh.scene import (
     Body,
     Scene,
     extract_gmsh,
@@ -48,11 +48,11 @@ MESHERS = ("gmsh", "layers")
 def hertz_contact_box(R=10.0, width=40.0, depth=20.0, zone=1.5, Ry=None, band=None, h=None):
     """The cells owned by rank 0, where the contact geometry is computed: the strip where the
     initial gap is at most `band` (the contact problem's, default the gap at x = 1.5 zone),
-    |x| <= x_band and 0 <= y <= band, inflated by meshes.scene.CONTACT_BOX_MARGIN h (default
-    h: zone / 10) and clipped to the bounding box of the two bodies (Ry: the indenter's
+    |x| <= x_band and 0 <= y <= band, inflated by dolfinx_forms.mesh.scene.CONTACT_BOX_MARGIN h
+    (default h: zone / 10) and clipped to the bounding box of the two bodies (Ry: the indenter's
     vertical semi-axis, default R). Only the strip: the fine zone below and above it goes to
     the other ranks (a square around the zone held 91 % of the dofs at a/20 on 2 ranks)."""
-    from .scene import CONTACT_BOX_MARGIN
+    from dolfinx_forms.mesh.scene import CONTACT_BOX_MARGIN
 
     top = R if Ry is None else Ry
     band = ellipse_sag(R, top, min(1.5 * zone, R)) if band is None else float(band)
@@ -212,7 +212,7 @@ def _layers(R, Ry, W, depth, z, h, h_far, growth):
     """Rank 0: both bodies as nested layers around the origin (meshes/layers.py): spacing
     h / sqrt(2) on the zone (the grid's diagonals h), growing by the ratio 1 + growth per layer
     up to h_far. Returns x (n, 2), triangles (m, 3) int64."""
-    from .cut import graded_lines
+    from dolfinx_forms.mesh.cut_scene import graded_lines
     from .layers import layer_mesh
 
     s = h / np.sqrt(2)

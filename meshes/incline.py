@@ -15,7 +15,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from .scene import Body, Scene, add_polygon, check_cells, gmsh_model, scene_from_gmsh, summary
+from dolfinx_forms.mesh.scene import (
+    Body,
+    Scene,
+    add_polygon,
+    check_cells,
+    gmsh_model,
+    scene_from_gmsh,
+    summary,
+)
 
 
 def incline_scene(comm, h=25.0, quads=False, size=1000.0, slope=0.2, intercept=458.6) -> Scene:

@@ -1,8 +1,8 @@
 """Scenes of the implicit MPM: cut scenes of grid level sets on one uniform background grid.
 
 `grid_scene(comm, xlines, ylines, bodies, ...)` returns the `build_scene(levelsets)` callback of
-`dolfinx_forms.mpm.ImplicitMPM`: every step it makes the cut scene of the current level sets
-(each body's window is the whole grid: only its level set decides its active cells). Also the
+`dolfinx_forms.mpm.implicit.ImplicitMPM`: every step it makes the cut scene of the current level
+sets (each body's window is the whole grid: only its level set decides its active cells). Also the
 Brazilian-disc set-up (paper 5.3.1): a disc between two rigid half-plane platens.
 """
 
@@ -11,10 +11,10 @@ from __future__ import annotations
 import numpy as np
 
 import dolfinx_forms as df
-from dolfinx_forms.boundary import Dirichlet
-from dolfinx_forms.obstacles import RigidObstacle
+from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.geometry.obstacles import RigidObstacle
 
-from .cut import CutBody, cut_scene, half_plane
+from dolfinx_forms.mesh.cut_scene import CutBody, cut_scene, half_plane
 
 
 def uniform_lines(lo, hi, h):
@@ -27,7 +27,7 @@ def grid_scene(comm, xlines, ylines, bodies, pairs=(), boundary_markers=None, co
     """build_scene(levelsets {tag: _cpp.LevelSet}, pairs=None, boxes=None) -> Scene for `bodies`
     [(name, tag)] on the grid; pairs: body-body contact pairs (indices into bodies; the
     simulation passes its broad phase's each step, else these); boxes: the simulation's contact
-    boxes with their ranks ({"boxes", "owners"}, meshes.scene.contact_partitioner), else
+    boxes with their ranks ({"boxes", "owners"}, dolfinx_forms.mesh.scene.contact_partitioner), else
     contact_box; boundary_markers: as in
     meshes.cut.cut_scene (default none); contact_box: the cells kept on rank 0 where contact is
     computed ((2, 2) or (k, 2, 2); None: from the pairs; required with obstacles in parallel)."""

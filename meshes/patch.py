@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .scene import (
+from dolfinx_forms.mesh.scene import (
     Body,
     Scene,
     add_polygon,
@@ -78,7 +78,7 @@ def patch_dirichlet(d, height=1.0):
     """The patch test's Dirichlet conditions on these boundary names (also those of
     meshes.cut.patch_cut_scene): bottom u_y = 0, top u_y = -d lam, and u_x = 0 at the left end
     of the bottom and of the top (one point per body: no rigid sliding)."""
-    from dolfinx_forms.solver import Dirichlet
+    from dolfinx_forms.fem.boundary import Dirichlet
 
     def corner(y):
         return lambda x: np.isclose(x[0], 0.0) & np.isclose(x[1], y)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .scene import (
+from dolfinx_forms.mesh.scene import (
     Body,
     Scene,
     add_polygon,

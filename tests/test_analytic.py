@@ -11,7 +11,7 @@ polynomial phi, so its error is the circle's non-polynomial remainder only."""
 import numpy as np
 import pytest
 
-from dolfinx_forms import analytic
+from dolfinx_forms.analysis import analytic
 
 
 def circle_numerical(a, R, E_star, n=40):

@@ -141,8 +141,9 @@ def test_traction_at_nodes_zero_mean_gap():
     pressure is coarser at the contact edge than the default point-wise traction's."""
     from mpi4py import MPI
 
-    from dolfinx_forms.checks import penetration
-    from dolfinx_forms.solver import ContactProblem, Dirichlet
+    from dolfinx_forms.solvers.checks import penetration
+    from dolfinx_forms.solvers.problem import ContactProblem
+    from dolfinx_forms.fem.boundary import Dirichlet
     from meshes.hertz import hertz_scene
 
     scene = hertz_scene(MPI.COMM_SELF, R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.6)
@@ -174,8 +175,9 @@ def _cut_hertz_force(al_first, al_eta, fresh_border=False):
     Newton. fresh_border: the force control's border solved every iteration (no reuse)."""
     from mpi4py import MPI
 
-    from dolfinx_forms import protocol
-    from dolfinx_forms.solver import ContactProblem, Dirichlet
+    from dolfinx_forms.solvers import protocol
+    from dolfinx_forms.solvers.problem import ContactProblem
+    from dolfinx_forms.fem.boundary import Dirichlet
     from meshes.cut import hertz_cut_scene
 
     sc = hertz_cut_scene(MPI.COMM_SELF, R=10.0, width=20.0, depth=10.0, h=0.25, zone=1.6)
@@ -234,7 +236,7 @@ def test_consistent_projection_returns_p1_fields():
     field sampled at the points (the lumped projection does not: it smooths a curved one)."""
     from mpi4py import MPI
 
-    from dolfinx_forms.solver import ContactProblem
+    from dolfinx_forms.solvers.problem import ContactProblem
     from meshes.hertz import hertz_scene
 
     scene = hertz_scene(MPI.COMM_SELF, R=10.0, width=20.0, depth=10.0, h=0.2, zone=1.6)
@@ -271,8 +273,8 @@ def test_hybrid_projection_rows():
     consistent row and the others the lumped one; frozen rows stay whatever is closed."""
     from mpi4py import MPI
 
-    from dolfinx_forms.contact import HYBRID_CLOSED_FRACTION
-    from dolfinx_forms.solver import ContactProblem
+    from dolfinx_forms.geometry.pairs import HYBRID_CLOSED_FRACTION
+    from dolfinx_forms.solvers.problem import ContactProblem
     from meshes.hertz import hertz_scene
 
     scene = hertz_scene(MPI.COMM_SELF, R=10.0, width=20.0, depth=10.0, h=0.2, zone=1.6)
@@ -352,8 +354,9 @@ def _cut_mindlin(direct):
     direct: the loop at the final eps_t from the start (no continuation)."""
     from mpi4py import MPI
 
-    from dolfinx_forms.protocol import friction_on, reach_force
-    from dolfinx_forms.solver import ContactProblem, Dirichlet
+    from dolfinx_forms.solvers.problem import ContactProblem
+    from dolfinx_forms.fem.boundary import Dirichlet
+    from dolfinx_forms.solvers.protocol import friction_on, reach_force
     from meshes.cut import hertz_cut_scene
 
     sc = hertz_cut_scene(MPI.COMM_SELF, R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.6)
@@ -379,7 +382,7 @@ def test_tangential_continuation_reaches_the_final_fixed_point():
     then goes on at eps_t = 1.0 h/E (solver.CONSISTENT_EPS0_T): its answer is the loop's at
     1.0 h/E alone (which converges at this coarse h; at a/20 from the committed tractions it
     can cycle), to the loop's tolerance (1e-7 of the largest traction; 2e-8 seen)."""
-    from dolfinx_forms.solver import CONSISTENT_EPS0_T, POINTWISE_EPS0_T
+    from dolfinx_forms.solvers.problem import CONSISTENT_EPS0_T, POINTWISE_EPS0_T
 
     runs = [_cut_mindlin(direct) for direct in (False, True)]
     cs = runs[0].contact

@@ -1,4 +1,4 @@
-"""dolfinx_forms/blas.py: the BLAS thread count follows the problem size, the user's
+"""dolfinx_forms/solvers/blas.py: the BLAS thread count follows the problem size, the user's
 OPENBLAS_NUM_THREADS wins."""
 
 import subprocess
@@ -11,7 +11,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 SCRIPT = """
 import os
-from dolfinx_forms import blas
+from dolfinx_forms.solvers import blas
 if blas.num_threads() is None:
     print("no-openblas")
 else:

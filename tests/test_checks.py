@@ -11,7 +11,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from dolfinx_forms.checks import PENETRATION, pair_warnings
+from dolfinx_forms.solvers.checks import PENETRATION, pair_warnings
 
 ROOT = Path(__file__).resolve().parents[1]
 H, BAND = 0.1, 0.2
@@ -169,7 +169,7 @@ def _rigid_factors(points, k_t, centre):
     `points` on a face of normal y: normal stiffness 1 and tangential k_t (0: the point
     slides) on each, J the springs' stiffness on the point displacements. R also samples two
     points off the face (rigid motions are measured on the whole body)."""
-    from dolfinx_forms.checks import stacked_rfactors
+    from dolfinx_forms.solvers.checks import stacked_rfactors
 
     def u(x):  # the displacement at x of c = (a, b, w), rotation about centre
         d = np.asarray(x, float) - centre
@@ -205,7 +205,7 @@ def test_free_rigid_modes_is_a_rank_test(points, k_t, expected):
     of the null space the SVD returns (the points' order, the body's centre)."""
     import re
 
-    from dolfinx_forms.checks import free_rigid_modes
+    from dolfinx_forms.solvers.checks import free_rigid_modes
 
     for centre in (np.zeros(2), np.array([0.7, 2.0])):
         for pts in (points, points[::-1]):

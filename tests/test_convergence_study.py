@@ -111,8 +111,8 @@ def test_work_precision_shares_the_runner():
     cs = load("convergence_study", DEMO)
     wp = load("work_precision", ROOT / "benchmarks" / "work_precision.py")
     # one runner: the benchmark calls the demo module's run_hertz (no second copy)
-    assert Path(wp.study.__file__).resolve() == Path(cs.__file__).resolve()
-    assert wp.study.run_hertz.__code__.co_firstlineno == cs.run_hertz.__code__.co_firstlineno
+    assert Path(wp.demo.__file__).resolve() == Path(cs.__file__).resolve()
+    assert wp.demo.run_hertz.__code__.co_firstlineno == cs.run_hertz.__code__.co_firstlineno
     assert wp.VARIANTS["q1-cut"] == ["--discretization", "cut"]
     assert wp.parse([]).variants == [
         "p1-tri",
@@ -128,8 +128,8 @@ def test_work_precision_shares_the_runner():
     assert al[:4] == ["--discretization", "cut", "--enforcement", "augmented"]
     assert al[4:] == ["--multiplier-mass", "lumped"]
     assert wp.parse(["--quick"]).variants == ["p1-tri", "q1-cut"]
-    assert cs.loglog_rate([1, 2, 4], [1, 4, 16]) == pytest.approx(2.0)
-    assert cs.loglog_rate([1, 1], [1, 2]) is None
+    assert wp.loglog_rate([1, 2, 4], [1, 4, 16]) == pytest.approx(2.0)
+    assert wp.loglog_rate([1, 1], [1, 2]) is None
 
 
 def test_work_precision_reference_measure(tmp_path):

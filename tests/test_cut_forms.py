@@ -1,4 +1,4 @@
-"""Cut-cell integration (dolfinx_forms/cut.py): any UFL form on the inside part of cut cells.
+"""Cut-cell integration (dolfinx_forms/fem/cut.py): any UFL form on the inside part of cut cells.
 
 Checks against independent formulations: FFCx's own rule on uncut cells (to round-off), the
 elastic energy of random Q1 fields against the sub-triangle rule of `cut_square_rule` (both
@@ -18,8 +18,8 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from dolfinx_forms import _cpp
-from dolfinx_forms.cut import CUT, GHOST, INTERIOR, CutIntegration
-from dolfinx_forms.laws import LinearElastic
+from dolfinx_forms.fem.cut import CUT, GHOST, INTERIOR, CutIntegration
+from dolfinx_forms.fem.laws import LinearElastic
 
 E, NU = 3.0, 0.3
 

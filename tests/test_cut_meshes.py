@@ -15,19 +15,9 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from meshes.cut import (
-    CUT,
-    INTERIOR,
-    CutBody,
-    cut_scene,
-    graded_lines,
-    half_plane,
-    hertz_cut_scene,
-    incline_cut_scene,
-    levelset_values,
-    patch_cut_scene,
-    two_blocks_cut_scene,
-)
+from dolfinx_forms.fem.cut import CUT, INTERIOR, levelset_values
+from dolfinx_forms.mesh.cut_scene import CutBody, cut_scene, graded_lines, half_plane
+from meshes.cut import hertz_cut_scene, incline_cut_scene, patch_cut_scene, two_blocks_cut_scene
 
 BUILDERS = {
     "hertz": lambda comm: hertz_cut_scene(comm, h=0.2),
@@ -387,7 +377,7 @@ def two_rank_report(comm):
     """Collective: per scene, the local checks on every rank plus the global counts; cells
     touching the contact box are all owned by rank 0."""
     from meshes.hertz import hertz_contact_box
-    from meshes.scene import cell_bboxes
+    from dolfinx_forms.mesh.scene import cell_bboxes
 
     with pytest.raises(ValueError, match="grid line"):  # raised on every rank, no hang
         patch_cut_scene(comm, n=4)

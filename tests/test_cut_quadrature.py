@@ -252,7 +252,7 @@ def test_elastic_energy_of_q1_fields_exact_with_three_points():
 
 
 def test_factors_follow_ffcx_points_in_a_quadrature_function():
-    """End to end, as dolfinx_forms.cut uses the weights: factor W_k / w_k in a Quadrature
+    """End to end, as dolfinx_forms.fem.cut uses the weights: factor W_k / w_k in a Quadrature
     function (dof k <-> basix point k), phi from the P1 dofmap (reference vertex order)."""
     q = 4
     msh = dmesh.create_rectangle(

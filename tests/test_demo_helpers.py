@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from dolfinx_forms import analytic, compare
-from dolfinx_forms.boundary import nearest_vertex_marker
+from dolfinx_forms.analysis import analytic, compare
+from dolfinx_forms.fem.boundary import nearest_vertex_marker
 
 
 def test_inclined_state_without_penalty():

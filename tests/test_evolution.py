@@ -1,7 +1,6 @@
 """Level-set evolution (eqs 19-20): normal extension, HJ-WENO5 / TVD-RK3 advection, gradient
 drift and the cut-polygon area. Measured numbers are quoted in the docstrings (Release build)."""
 
-import time
 
 import numpy as np
 import pytest
@@ -177,17 +176,16 @@ def test_zalesak_disc_one_revolution():
     assert s2 < 0.004 and s1 / s2 > 3.0, (s1, s2)
 
 
-def test_advect_speed_and_substeps():
-    """250^2 grid, displacement 0.1 h: one substep, about 10 ms here (including the Hermite
-    set-up of the returned LevelSet); bound 0.5 s. Displacement (2h, h) at cfl 0.5: 6 substeps."""
+def test_advect_substeps():
+    """250^2 grid, displacement 0.1 h: one substep. Displacement (2h, h) at cfl 0.5: 6
+    substeps. (Its cost, about 10 ms here: benchmarks/geometry_timings.py.)"""
     n = 250
     g = unit_grid(n)
     X = g.nodes()
     phi = _cpp.LevelSet(g, np.hypot(X[:, 0] - 0.4, X[:, 1] - 0.5) - 0.25)
     v = np.tile([0.1 / n, 0.05 / n], (X.shape[0], 1))
-    t = time.perf_counter()
     res = _cpp.advect_levelset(phi, v)
-    assert time.perf_counter() - t < 0.5 and res["substeps"] == 1
+    assert res["substeps"] == 1
     assert _cpp.advect_levelset(phi, np.tile([2.0 / n, 1.0 / n], (X.shape[0], 1)))["substeps"] == 6
     z = _cpp.advect_levelset(phi, np.zeros_like(X), time=3.0)
     assert np.array_equal(z["levelset"].values, phi.values)

@@ -1,6 +1,6 @@
 """GetFEM's nodal P1 Hertz (benchmarks/getfem_hertz.py), the reference of the work-precision
 comparison: it reaches the load P by force control, its contact half-width is Hertz's and its
-p(x) error (the definition of dolfinx_forms/compare.py) is small and decreases with h.
+p(x) error (the definition of dolfinx_forms/analysis/compare.py) is small and decreases with h.
 Skipped without python3-getfem (CI does not install it; `make bench` does). ~2 s.
 
 The bounds. The error is dominated by the two edge segments of the contact zone, where the P1

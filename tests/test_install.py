@@ -33,7 +33,7 @@ SCRIPT = textwrap.dedent(
     import dolfinx_forms
     import meshes
     from dolfinx_forms import _cpp
-    from dolfinx_forms.solver import ContactProblem
+    from dolfinx_forms.solvers.problem import ContactProblem
     from meshes.cut import patch_cut_scene
     from meshes.patch import patch_dirichlet
 

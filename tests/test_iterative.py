@@ -1,15 +1,15 @@
-"""The iterative linear solver (dolfinx_forms.linear.Iterative: CG + GAMG with the rigid-body
-modes as near-null space) against the factorised one, its near-null space, and its iteration
-counts on small cut cells."""
+"""The iterative linear solver (dolfinx_forms.solvers.linear.Iterative: CG + GAMG with the
+rigid-body modes as near-null space) against the factorised one, its near-null space, and its
+iteration counts on small cut cells."""
 
 import numpy as np
 import pytest
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_forms import linear, protocol
-from dolfinx_forms.newton import ContactSolverError
-from dolfinx_forms.solver import ContactProblem
+from dolfinx_forms.solvers import linear, protocol
+from dolfinx_forms.solvers.newton import ContactSolverError
+from dolfinx_forms.solvers.problem import ContactProblem
 
 from test_linear import P, hertz_problem, scene
 

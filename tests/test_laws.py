@@ -9,9 +9,11 @@ from dolfinx import fem, mesh as dmesh
 from mpi4py import MPI
 
 from dolfinx_forms import Box
-from dolfinx_forms.laws import LinearElastic, NeoHookean, OrthotropicElastic
-from dolfinx_forms.solver import ContactProblem, Dirichlet, NewtonOptions
-from meshes.scene import Body, Scene, tag_boundaries
+from dolfinx_forms.fem.laws import LinearElastic, NeoHookean, OrthotropicElastic
+from dolfinx_forms.mesh.scene import Body, Scene, tag_boundaries
+from dolfinx_forms.solvers.problem import ContactProblem
+from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.solvers.newton import NewtonOptions
 
 E, NU = 1000.0, 0.3
 W, H, A = 2.0, 1.0, 0.25  # block [-W/2, W/2] x [0, H], punch half-width A
@@ -116,9 +118,9 @@ def test_neo_hookean_punch_large_load_quadratic_newton():
 def cut_block_scene(comm=MPI.COMM_WORLD, h=1 / 16):
     """The block on a cut grid, its bottom cut by the slanted line y = 0.1 + 0.1 x (cut cells
     all along it), clamped on its left and right sides, the punch on the top."""
-    from meshes.from_spec import build_scene
+    from dolfinx_forms.mesh.from_spec import build_scene
 
-    from dolfinx_forms import scene_spec
+    from dolfinx_forms.app import scene_spec
 
     spec = scene_spec.load(
         {

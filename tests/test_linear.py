@@ -1,6 +1,7 @@
-"""Newton's linear solves (dolfinx_forms.linear): the condensed bulk (one sparse factorisation,
-Newton on the dense Schur complement of the contact dofs) against a full factorisation per
-iteration, on the same frictional Hertz path (normal force, then a tangential one), both paths.
+"""Newton's linear solves (dolfinx_forms.solvers.linear): the condensed bulk (one sparse
+factorisation, Newton on the dense Schur complement of the contact dofs) against a full
+factorisation per iteration, on the same frictional Hertz path (normal force, then a tangential
+one), both paths.
 
 Both solve J du = -R exactly (direct solvers): the iterates, hence the converged states, agree
 to round-off amplified by the conditioning, far below the Newton tolerance (1e-10 of R)."""
@@ -9,9 +10,10 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from dolfinx_forms import linear, protocol
-from dolfinx_forms.laws import NeoHookean
-from dolfinx_forms.solver import ContactProblem, Dirichlet
+from dolfinx_forms.fem.laws import NeoHookean
+from dolfinx_forms.solvers import linear, protocol
+from dolfinx_forms.solvers.problem import ContactProblem
+from dolfinx_forms.fem.boundary import Dirichlet
 
 E, NU, R, P = 1.0e4, 0.3, 10.0, 430.0
 pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial: MUMPS Schur")
@@ -189,8 +191,8 @@ def test_tangent_kept_while_its_key_holds(kind, enforcement, monkeypatch):
     assembled for skips the tangent's assembly. The Mindlin path (two force controls, mu
     switched on, slip) gives the same iterates as assembling J every iteration, with fewer
     assemblies."""
-    from dolfinx_forms import newton
-    from dolfinx_forms.solver import ContactProblem as CP
+    from dolfinx_forms.solvers import newton
+    from dolfinx_forms.solvers.problem import ContactProblem as CP
 
     sc = scene(kind)
     counts = []

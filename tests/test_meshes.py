@@ -16,7 +16,7 @@ from meshes import (  # noqa: E402
     patch_scene,
     two_blocks_scene,
 )
-from meshes.scene import cell_bboxes, cell_edges, max_edge_in_box  # noqa: E402
+from dolfinx_forms.mesh.scene import cell_bboxes, cell_edges, max_edge_in_box  # noqa: E402
 
 R, W, D = 10.0, 20.0, 20.0  # hertz defaults (width 40, depth 20)
 S, SLOPE, C0 = 1000.0, 0.2, 458.6  # incline defaults
@@ -344,8 +344,9 @@ def test_hertz_scenes_refuse_sizes_they_cannot_mesh(kind):
     ],
 )
 def test_scene_builders_refuse_more_cells_than_they_can_hold(module, builder, kwargs):
-    """meshes.scene.check_cells: an estimate of the cells above MAX_CELLS is a ValueError naming
-    the builder, before gmsh or numpy start (they ran for minutes or died on memory)."""
+    """dolfinx_forms.mesh.scene.check_cells: an estimate of the cells above MAX_CELLS is a
+    ValueError naming the builder, before gmsh or numpy start (they ran for minutes or died on
+    memory)."""
     import importlib
 
     make = getattr(importlib.import_module(module), builder)

@@ -1,6 +1,6 @@
 """A user scene built without a contact box works on 2 ranks (run under mpirun -n 2): the box
-is derived from the contact pairs (meshes.scene.pairs_contact_boxes), its cells are owned by
-rank 0 where the contact geometry is computed, and the patch test gives the reaction of one
+is derived from the contact pairs (dolfinx_forms.mesh.scene.pairs_contact_boxes), its cells are
+owned by rank 0 where the contact geometry is computed, and the patch test gives the reaction of one
 rank and the penalised exact pressure. DOLFINx's own partitioner (contact_box=False) would
 put cells of that box on rank 1: the case that used to raise on rank 0 and hang rank 1."""
 
@@ -9,10 +9,10 @@ import pytest
 from mpi4py import MPI
 
 import dolfinx_forms as df
-from dolfinx_forms.solver import ContactProblem
-from meshes.cut import CutBody, cut_scene, half_plane
+from dolfinx_forms.mesh.cut_scene import CutBody, cut_scene, half_plane
+from dolfinx_forms.solvers.problem import ContactProblem
 from meshes.patch import patch_dirichlet
-from meshes.scene import (
+from dolfinx_forms.mesh.scene import (
     Body,
     add_polygon,
     cell_bboxes,

@@ -10,7 +10,7 @@ import pytest
 from mpi4py import MPI
 from test_mpm import disc_sim
 
-from dolfinx_forms.newton import NewtonOptions
+from dolfinx_forms.solvers.newton import NewtonOptions
 
 
 def run(comm, steps=10):
@@ -47,7 +47,7 @@ def test_brazilian_disc_two_ranks_match_one():
 def assembly(comm, steps=2, mu=np.tan(np.radians(15)), n=9):
     from test_mpm import quiet
 
-    from dolfinx_forms.mpm import ImplicitMPM, MPMBody
+    from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
     from meshes.assembly import grain_assembly
 
     grid, bodies, plates, build, _, _ = grain_assembly(comm, n, h=0.5, aspect=1.1, overlap=0.01)

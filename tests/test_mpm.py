@@ -1,16 +1,16 @@
-"""The implicit MPM step loop (dolfinx_forms.mpm): rigid motion, a block between rigid platens,
-the Brazilian disc on a coarse grid, and rejected steps."""
+"""The implicit MPM step loop (dolfinx_forms.mpm.implicit): rigid motion, a block between rigid
+platens, the Brazilian disc on a coarse grid, and rejected steps."""
 
 import numpy as np
 import pytest
 from mpi4py import MPI
 
 import dolfinx_forms as df
-from dolfinx_forms.boundary import Dirichlet
-from dolfinx_forms.mpm import ImplicitMPM, MPMBody
-from dolfinx_forms.newton import ContactSolverError, NewtonOptions
-from dolfinx_forms.obstacles import RigidObstacle
-from meshes.cut import half_plane
+from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.geometry.obstacles import RigidObstacle
+from dolfinx_forms.mesh.cut_scene import half_plane
+from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
+from dolfinx_forms.solvers.newton import ContactSolverError, NewtonOptions
 from meshes.mpm import brazilian_disc, grid_scene, uniform_lines
 
 COMM = MPI.COMM_SELF
@@ -65,7 +65,7 @@ def test_block_between_frictionless_platens_gives_the_uniaxial_force():
     stress, F = W E' d / (H + 2 E' eps_n) with E' = E / (1 - nu^2) (the penalty compliance of
     both contacts in series), within 1 %. The block spans the grid's width (its sides are the
     grid's edges, traction free): a square's corners would enter Gamma_c, where the C1
-    interpolant of a cornered distance bulges by ~0.1 h (see docs/demos.md#brazilian-disc)."""
+    interpolant of a cornered distance bulges by ~0.1 h (see docs/demos/brazilian_disc.md)."""
     h, E, nu, L, step = 0.1, 1000.0, 0.3, 1.03, 0.0005
     xl, yl = uniform_lines(-1.0, 1.0, h), uniform_lines(-L - 0.3, L + 0.3, h)
     W = xl[-1] - xl[0]
@@ -337,7 +337,7 @@ def test_q1_basis_is_basix_q1():
     element, values and first derivatives, inside the square and extrapolated outside."""
     import basix
 
-    from dolfinx_forms.material_points import q1_basis
+    from dolfinx_forms.mpm.material_points import q1_basis
 
     X = np.random.default_rng(0).uniform(-0.3, 1.3, (200, 2))
     el = basix.create_element(basix.ElementFamily.P, basix.CellType.quadrilateral, 1)
@@ -347,7 +347,7 @@ def test_q1_basis_is_basix_q1():
 def test_binned_mean_is_the_pixel_mean():
     """mpm_output.binned_mean (the force-chain plot's background): the mean of the values of
     the points in each pixel, blank (NaN) where none falls, rows along y."""
-    from dolfinx_forms.mpm_output import binned_mean
+    from dolfinx_forms.app.mpm_run import binned_mean
 
     # 4 points in each of the pixels (0, 0), (1, 0), (0, 1) of a 2 x 2 image of side 1
     c = np.array([[0.25, 0.25], [0.75, 0.25], [0.25, 0.75], [0.75, 0.75]]) * 0.5

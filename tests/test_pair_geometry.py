@@ -12,7 +12,12 @@ from mpi4py import MPI
 
 import dolfinx_forms as df
 from dolfinx_forms import _cpp
-from dolfinx_forms.contact import body_levelset, closest_points, has_exact_shape, pair_geometry
+from dolfinx_forms.geometry.pairs import (
+    body_levelset,
+    closest_points,
+    has_exact_shape,
+    pair_geometry,
+)
 
 R = 10.0
 
@@ -114,7 +119,7 @@ def test_near_box_leaves_the_contact_unchanged(hertz, monkeypatch):
     (contact.near_box: |x| < ~2 a instead of the 20 R wide overlap) gives the same Gamma_c
     (same lattice: weights and normals to round-off) and the same closest points to the
     projection's tolerance (1e-8 relative: its start differs)."""
-    from dolfinx_forms import contact
+    from dolfinx_forms.geometry import pairs as contact
 
     scene, V = hertz
     band = 0.2
@@ -137,7 +142,7 @@ def test_near_box_leaves_the_contact_unchanged(hertz, monkeypatch):
 def test_split_segments_and_label_breaks():
     """Pieces split where a label of their points changes (a k-ary search), never into pieces
     shorter than tol, and the ends of the multiplier elements along a chain."""
-    from dolfinx_forms.contact import label_breaks, multiplier_breaks, split_segments
+    from dolfinx_forms.geometry.pairs import label_breaks, multiplier_breaks, split_segments
 
     pieces = np.array([[[0.0, 0.0], [1.0, 0.0]], [[2.0, 0.0], [1.0, 0.0]]])  # one chain, 2 pieces
     cells = np.array([7, 8], np.int32)
@@ -178,7 +183,7 @@ def test_beyond_end_flags_points_past_a_corner_only():
     """Gamma_c along y = 0, a body ending at x = 0 (its corner): past the corner the offset to
     the closest point runs along Gamma_c; inside the face's shadow it is across (a gap), also
     tilted by a curved partner's normal (up to 45 degrees)."""
-    from dolfinx_forms.contact import beyond_end
+    from dolfinx_forms.geometry.pairs import beyond_end
 
     n = np.tile([0.0, 1.0], (5, 1))
     pts = np.array([[-0.3, 0.0], [-1e-9, 0.0], [0.2, 0.0], [0.5, 0.01], [0.7, 0.0]])
@@ -218,7 +223,7 @@ def test_mass_solver_dense_and_sparse(monkeypatch):
     """contact.mass_solver: numpy's dense inverse (small pairs: no scipy import) and scipy's
     sparse LU (above DENSE_MASS_NODES) solve the same hat mass matrix, repeated entries summed
     and a diagonal added (the hybrid projection's lumped rows)."""
-    from dolfinx_forms import contact
+    from dolfinx_forms.geometry import pairs as contact
 
     rng = np.random.default_rng(3)
     n = 40

@@ -1,4 +1,4 @@
-"""Under mpirun an error on one rank ends every rank (dolfinx_forms/parallel.py), and a bad
+"""Under mpirun an error on one rank ends every rank (dolfinx_forms/app/mpi_errors.py), and a bad
 argument gives exit status 2 on every rank. Serial tests that start `mpirun -n 2`."""
 
 import os
@@ -40,7 +40,7 @@ def test_error_on_one_rank_ends_all(tmp_path):
     script = textwrap.dedent(
         """
         import time
-        import dolfinx_forms  # noqa: F401  (installs the hook under mpirun)
+        import dolfinx_forms.app  # noqa: F401  (the start-up installs the hook under mpirun)
         from mpi4py import MPI
         comm = MPI.COMM_WORLD
         if comm.rank == 1:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from dolfinx_forms import cli
+from dolfinx_forms.app import cli
 
 ROOT = Path(__file__).resolve().parents[1]
 

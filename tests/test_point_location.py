@@ -1,6 +1,5 @@
 """Point location on DOLFINx meshes (CellLocator) against dolfinx.geometry and the P1 basis."""
 
-import time
 
 import basix
 import numpy as np
@@ -135,44 +134,11 @@ def test_bad_shapes_raise_value_error():
         loc.locate(np.zeros((4, 2)), -1.0)
 
 
-@pytest.mark.parametrize("cell_type", CELL_TYPES)
-def test_timing_200x200(cell_type):
-    """Throughput print (not asserted): 1e5 random points on a 200 x 200 mesh."""
-    mesh = create_unit_square(MPI.COMM_SELF, 200, 200, cell_type)
-    x, cells = mesh_arrays(mesh)
-    pts = np.random.default_rng(2).random((100_000, 2))
-    t0 = time.perf_counter()
-    loc = CellLocator(x, cells)
-    t1 = time.perf_counter()
-    r = loc.locate(pts, 0.0)
-    t2 = time.perf_counter()
-    order = np.lexsort((pts[:, 0], np.floor(pts[:, 1] * 200)))  # spatially coherent queries
-    t3 = time.perf_counter()
-    loc.locate(pts[order], 0.0)
-    t4 = time.perf_counter()
-    p3 = np.c_[pts, np.zeros(len(pts))]
-    tree = dolfinx.geometry.BoundingBoxTree(mesh, 2)
-    t5 = time.perf_counter()
-    coll = dolfinx.geometry.compute_colliding_cells(
-        mesh, dolfinx.geometry.compute_collisions(tree, p3), p3
-    )
-    t6 = time.perf_counter()
-    assert np.all(r["cells"] >= 0)
-    assert r["cells"][7] in coll.links(7)
-    print(
-        f"\n[timing] {cell_type.name} 200x200 ({len(cells)} cells): CellLocator build "
-        f"{1e3 * (t1 - t0):.1f} ms, locate 1e5 random points {1e3 * (t2 - t1):.1f} ms "
-        f"({1e5 / (t2 - t1):.2e} points/s), sorted points {1e5 / (t4 - t3):.2e} points/s; "
-        f"dolfinx BoundingBoxTree build {1e3 * (t5 - t4):.1f} ms, collisions "
-        f"{1e3 * (t6 - t5):.1f} ms ({1e5 / (t6 - t5):.2e} points/s)"
-    )
-
-
 def test_grid_locator_matches_binned_location_on_a_cut_scene():
     """Cut scenes locate points by grid index (O(1)); same cells and reference coordinates as
     the binned C++ locator for points inside active cells, and the nearest active cell for
     points in inactive grid cells near the boundary."""
-    from dolfinx_forms.contact import BodyLocator, GridLocator
+    from dolfinx_forms.geometry.pairs import BodyLocator, GridLocator
     from meshes.cut import hertz_cut_scene
 
     scene = hertz_cut_scene(MPI.COMM_SELF, R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.0)

@@ -1,4 +1,4 @@
-"""Load protocols (dolfinx_forms.protocol) on the cut patch test (n = 3: 3 x 3 cells, the
+"""Load protocols (dolfinx_forms.solvers.protocol) on the cut patch test (n = 3: 3 x 3 cells, the
 interface y = 0.5 cuts the middle row).
 
 The frictionless patch problem is linear while the interface stays closed: the reaction on the
@@ -11,8 +11,10 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from dolfinx_forms import protocol
-from dolfinx_forms.solver import ContactProblem, ContactSolverError, Dirichlet, Traction
+from dolfinx_forms.solvers import protocol
+from dolfinx_forms.solvers.problem import ContactProblem
+from dolfinx_forms.solvers.newton import ContactSolverError
+from dolfinx_forms.fem.boundary import Dirichlet, Traction
 
 E, NU, N = 1.0, 0.3, 3
 

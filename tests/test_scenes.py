@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from dolfinx_forms import analytic
-from dolfinx_forms.scene_spec import SpecError, load
+from dolfinx_forms.analysis import analytic
+from dolfinx_forms.app.scene_spec import SpecError, load
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "demos" / "scenes"
@@ -136,8 +136,8 @@ def test_soft_disc_between_stiff_blocks_augmented(tmp_path, h):
 def test_contact_modulus():
     from types import SimpleNamespace as NS
 
-    from dolfinx_forms.laws import LinearElastic
-    from dolfinx_forms.solver import contact_modulus
+    from dolfinx_forms.fem.laws import LinearElastic
+    from dolfinx_forms.solvers.problem import contact_modulus
 
     bodies = [NS(tag=1), NS(tag=2), NS(tag=3)]
     laws = {1: LinearElastic(1e4, 0.3), 2: LinearElastic(1e4, 0.3), 3: LinearElastic(1e2, 0.3)}
@@ -184,7 +184,8 @@ def test_failed_check(tmp_path):
         (["--set", "stages=[{kind='ramp', to={nope=1.0}}]"], "stages[0].to.nope"),
         (["--set", "bodies[0].window=[[0.0,0.0],[1.0,0.6]]"], "bodies[0].window"),  # the grid
         (["--set", "dirichlet[2].point=[0.1,0.0]"], "dirichlet[2].point"),  # the mesh
-        # more cells than a builder makes (meshes.scene.MAX_CELLS): was a numpy MemoryError
+        # more cells than a builder makes (dolfinx_forms.mesh.scene.MAX_CELLS): was a numpy
+        # MemoryError
         (["--set", "discretization.h=1e-7"], "discretization.h"),
         (["--set", "discretization.cells=[100000,100000]"], "discretization.cells"),
     ],
@@ -282,8 +283,9 @@ def test_description_defaults():
 
 
 def test_fitted_patch(tmp_path):
-    """The gmsh path of meshes.from_spec: the patch on structured body-fitted quadrilaterals
-    (the boxes meet at y = 0.5 on matching edges) reproduces the penalised pressure."""
+    """The gmsh path of dolfinx_forms.mesh.from_spec: the patch on structured body-fitted
+    quadrilaterals (the boxes meet at y = 0.5 on matching edges) reproduces the penalised
+    pressure."""
     from dolfinx_forms import run
 
     spec = patch_dict()

@@ -22,7 +22,7 @@ def _python(code, **env):
 
 IMPORTS = """
 import json, os, sys
-import dolfinx_forms, dolfinx, dolfinx.fem.petsc, ufl, ffcx
+import dolfinx_forms.app, dolfinx, dolfinx.fem.petsc, ufl, ffcx
 from mpi4py import MPI
 print(json.dumps(dict(
     modules=[m for m in ("gmsh", "pkg_resources", "matplotlib") if m in sys.modules],
@@ -31,10 +31,11 @@ print(json.dumps(dict(
 """
 
 
-def test_library_import_is_lean():
-    """No gmsh, pkg_resources or matplotlib on import; ufl and ffcx know their versions; the
-    singleton's MPI settings are gone from the environment (an mpirun started from here must
-    not inherit btl=self)."""
+def test_application_start_is_lean():
+    """The application's start-up (dolfinx_forms.app.startup, what every demo and the runner
+    run): no gmsh, pkg_resources or matplotlib on import; ufl and ffcx know their versions;
+    the singleton's MPI settings are gone from the environment (an mpirun started from here
+    must not inherit btl=self). The library's own import does nothing: test_layout.py."""
     r = _python(IMPORTS)
     assert r["modules"] == []
     assert r["env"] == {"OMPI_MCA_pml": None, "OMPI_MCA_btl": None}
@@ -52,7 +53,7 @@ def test_user_mpi_settings_kept():
 
 def test_pkg_resources_still_works_after():
     r = _python(
-        "import json, dolfinx_forms, pkg_resources\n"
+        "import json, dolfinx_forms.app, pkg_resources\n"
         "print(json.dumps([pkg_resources.get_distribution('fenics-ufl').version,"
         " hasattr(pkg_resources, 'iter_entry_points')]))"
     )
@@ -73,7 +74,7 @@ def test_cut_demo_imports(tmp_path):
     assert r == []
     r = _python(
         "import json, sys\n"
-        "from meshes.scene import gmsh_model\n"
+        "from dolfinx_forms.mesh.scene import gmsh_model\n"
         "print(json.dumps([m for m in ('dolfinx', 'mpi4py') if m in sys.modules]))"
     )
     assert r == []
@@ -89,7 +90,7 @@ def _lines():
 def test_plot_worker_draws_the_same_png(tmp_path):
     """The worker's PNG is byte for byte the in-process one; it is used once, then plot_lines
     draws in-process again."""
-    from dolfinx_forms import output, plot_worker
+    from dolfinx_forms.io import output, plot_worker
 
     plot_worker.draw(tmp_path / "here.png", _lines(), "t", "x", "y", (0.5,))
     output._worker = worker = plot_worker.Worker()  # start_plot_worker: none on a busy machine
@@ -104,7 +105,7 @@ def test_plot_worker_errors_and_unused(tmp_path):
     """An error in the worker is raised in the caller; an unused worker is ended."""
     import pytest
 
-    from dolfinx_forms import output, plot_worker
+    from dolfinx_forms.io import output, plot_worker
 
     output._worker = plot_worker.Worker()
     with pytest.raises(RuntimeError, match="plot worker"):
@@ -115,7 +116,7 @@ def test_plot_worker_errors_and_unused(tmp_path):
 
 
 def test_plot_worker_only_when_a_core_is_idle(monkeypatch):
-    from dolfinx_forms import plot_worker
+    from dolfinx_forms.io import plot_worker
 
     monkeypatch.setattr(plot_worker.os, "getloadavg", lambda: (64.0, 64.0, 64.0))
     assert plot_worker.start() is None
@@ -130,7 +131,7 @@ def test_plot_worker_started_early_for_a_demo(monkeypatch, tmp_path):
     plot takes it over; another script, another rank or ILS_EARLY_PLOT=0 does not start it."""
     import types
 
-    from dolfinx_forms import output, plot_worker
+    from dolfinx_forms.io import output, plot_worker
 
     started = []
     monkeypatch.setattr(plot_worker, "start", lambda: started.append(1) or "worker")
@@ -171,15 +172,19 @@ def test_exit_process_status():
     """cli.exit_process: the status reaches the shell (0, 1)."""
     for status in (0, 1):
         p = subprocess.run(
-            [sys.executable, "-c", f"from dolfinx_forms import cli; cli.exit_process({status})"],
+            [
+                sys.executable,
+                "-c",
+                f"from dolfinx_forms.app import cli; cli.exit_process({status})",
+            ],
             env=dict(os.environ, PYTHONPATH=str(ROOT)),
         )
         assert p.returncode == status
 
 
 def test_gmsh_preloaded_with_its_own_scope():
-    """meshes.scene.import_gmsh after DOLFINx's import: libgmsh is mapped once (gmsh.py found
-    the preloaded library open) and meshes as before: a unit disc at size 0.2 gives the same
+    """dolfinx_forms.mesh.scene.import_gmsh after DOLFINx's import: libgmsh is mapped once (gmsh.py
+    found the preloaded library open) and meshes as before: a unit disc at size 0.2 gives the same
     node count as gmsh imported first in another process."""
     code = """
 import json, sys
@@ -187,7 +192,7 @@ first = sys.argv[1] == "first"
 if first:
     import gmsh
 import dolfinx_forms, dolfinx, dolfinx.fem.petsc
-from meshes.scene import import_gmsh
+from dolfinx_forms.mesh.scene import import_gmsh
 gmsh = import_gmsh()
 maps = {l.split()[-1] for l in open("/proc/self/maps") if "libgmsh" in l}
 gmsh.initialize(); gmsh.option.setNumber("General.Terminal", 0)

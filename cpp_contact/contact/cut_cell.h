@@ -28,7 +28,7 @@ constexpr int max_triangles = 4;
 /// Layout of the packed coefficients `w` that the cut kernels read (one source of truth: the
 /// Python forms are built to match it and check it). Traction form: w = [phi(4), t(18)] with t
 /// a vector Q2 function (9 nodes x 2, interleaved). Cell integrals of any UFL form on cut cells
-/// do not need a kernel: FFCx's rule with `moment_fitted_weights` (dolfinx_forms/cut.py).
+/// do not need a kernel: FFCx's rule with `moment_fitted_weights` (dolfinx_forms/fem/cut.py).
 struct Layout {
   static constexpr int phi = 0;      ///< offset of the 4 vertex values of phi
   static constexpr int traction = 4; ///< offset of the Q2 vector traction (linear form)

@@ -332,7 +332,7 @@ def test_real_command_line(batch, key, tmp_path):
 
 def test_petsc_defaults_are_the_solvers():
     """The --petsc trial solve starts from the linear solver's own defaults."""
-    from dolfinx_forms import cli
+    from dolfinx_forms.app import cli
 
-    linear = pytest.importorskip("dolfinx_forms.linear")
+    linear = pytest.importorskip("dolfinx_forms.solvers.linear")
     assert cli.SOLVER_DEFAULTS == linear.DEFAULT_OPTIONS

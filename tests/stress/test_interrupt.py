@@ -35,7 +35,7 @@ WRAPPER = textwrap.dedent(
         import gmsh  # noqa: F401  (SIGINT: default action from here on)
     sys.argv = [demo] + sys.argv[4:]
     if phase == "writing":
-        import dolfinx_forms.results as results
+        import dolfinx_forms.io.results as results
 
         write_metrics = results.write_metrics
 
@@ -46,7 +46,7 @@ WRAPPER = textwrap.dedent(
 
         results.write_metrics = wait_then_write
     else:
-        import dolfinx_forms.protocol as protocol
+        import dolfinx_forms.solvers.protocol as protocol
 
         ramp = protocol.ramp
 

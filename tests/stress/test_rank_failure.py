@@ -23,7 +23,7 @@ WRAPPER = textwrap.dedent(
     """
     import runpy, sys
 
-    import dolfinx_forms.results as results  # rank 0 writes metrics.json, the last file
+    import dolfinx_forms.io.results as results  # rank 0 writes metrics.json, the last file
 
     def fail(*args, **kwargs):
         raise OSError(28, "No space left on device (injected)")

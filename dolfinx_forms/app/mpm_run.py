@@ -1,0 +1,327 @@
+"""Outputs of the multi-step (MPM) runs: step tables, time series, and the run skeleton.
+
+Files (the contract of docs/contract.md, "Multi-step and multi-body outputs"):
+`steps.csv` (the demo's columns), `contacts.csv` (step, body_i, body_j, x, y, normal_force,
+tangential_force, active_length, stick_fraction), `bodies.csv` (step, body, fx, fy, moment,
+area_levelset, volume_points), and two XDMF time series that ParaView opens:
+`material_points.xdmf` (the points at their current positions with stress, volume and
+displacement since the start) and `levelsets.xdmf` (the background grid with each body's level
+set and extended step displacement). The series store raw little-endian float64 files beside the
+.xdmf (XDMF "Binary" items; no HDF5 needed), one frame every `series_every` steps.
+
+`run_steps` is the skeleton of a multi-step demo, as `demo.run_case` is for one load path:
+metrics record and phase timer -> build the simulation -> steps (a ContactSolverError or a
+RuntimeError of the step's geometry ends the run: one line on stderr, nothing written, exit
+status 1) -> evaluate (rank 0) -> one atomic
+folder -> summary and "results in ...".
+"""
+
+from __future__ import annotations
+
+import csv
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from dolfinx_forms.app.demo import problem_options
+from dolfinx_forms.io.results import PhaseTimer, new_metrics
+from dolfinx_forms.solvers.newton import ContactSolverError
+
+CONTACT_COLUMNS = [
+    "step",
+    "body_i",
+    "body_j",
+    "x",
+    "y",
+    "normal_force",
+    "tangential_force",
+    "active_length",
+    "stick_fraction",
+]
+BODY_COLUMNS = ["step", "body", "fx", "fy", "moment", "area_levelset", "volume_points"]
+
+
+def write_csv(path, columns, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(columns)
+        for r in rows:
+            w.writerow([r[c] for c in columns])
+
+
+class Series:
+    """An XDMF temporal collection of frames, each with its own geometry (module docstring)."""
+
+    def __init__(self, name):
+        self.name, self.frames = name, []
+
+    def add(self, time_value, points, point_data, cells=None):
+        """points (n, 2); point_data {name: (n,) or (n, c)}; cells (m, 4) quadrilaterals in
+        DOLFINx order, or None for a cloud of points."""
+        self.frames.append((float(time_value), np.asarray(points, float), point_data, cells))
+
+    def write(self, folder):
+        folder = Path(folder)
+        grids = []
+        for k, (t, x, data, cells) in enumerate(self.frames):
+            n = len(x)
+            xyz = np.zeros((n, 3))
+            xyz[:, : x.shape[1]] = x
+            items = [self._blob(folder, f"{k}_geometry", xyz)]
+            if cells is None:
+                topo = f'<Topology TopologyType="Polyvertex" NumberOfElements="{n}" />'
+            else:
+                vtk = np.ascontiguousarray(np.asarray(cells)[:, [0, 1, 3, 2]], dtype=np.int64)
+                topo = (
+                    f'<Topology TopologyType="Quadrilateral" NumberOfElements="{len(vtk)}">'
+                    + self._item(folder, f"{k}_topology", vtk)
+                    + "</Topology>"
+                )
+            attrs = []
+            for name, v in data.items():
+                v = np.asarray(v, float)
+                kind = "Scalar" if v.ndim == 1 else "Vector" if v.shape[1] <= 3 else "Tensor"
+                if kind == "Vector" and v.shape[1] == 2:
+                    v = np.hstack([v, np.zeros((n, 1))])
+                attrs.append(
+                    f'<Attribute Name="{name}" AttributeType="{kind}" Center="Node">'
+                    + self._item(folder, f"{k}_{name}", v)
+                    + "</Attribute>"
+                )
+            grids.append(
+                f'<Grid Name="frame{k}" GridType="Uniform"><Time Value="{t:.17g}" />{topo}'
+                f'<Geometry GeometryType="XYZ">{items[0]}</Geometry>{"".join(attrs)}</Grid>'
+            )
+        text = (
+            '<?xml version="1.0"?>\n<Xdmf Version="3.0"><Domain>'
+            f'<Grid Name="{self.name}" GridType="Collection" CollectionType="Temporal">'
+            + "\n".join(grids)
+            + "</Grid></Domain></Xdmf>\n"
+        )
+        (folder / f"{self.name}.xdmf").write_text(text)
+
+    def _blob(self, folder, key, a):
+        return self._item(folder, key, a)
+
+    def _item(self, folder, key, a):
+        a = np.ascontiguousarray(a)
+        fname = f"{self.name}_{key}.bin"
+        a.astype(a.dtype.newbyteorder("<")).tofile(folder / fname)
+        dtype, prec = ("Int", 8) if a.dtype.kind == "i" else ("Float", 8)
+        dims = " ".join(str(d) for d in a.shape)
+        return (
+            f'<DataItem Dimensions="{dims}" NumberType="{dtype}" Precision="{prec}" '
+            f'Format="Binary" Endian="Little">{fname}</DataItem>'
+        )
+
+
+def add_frames(sim, points_series, grid_series, step, x0):
+    """One frame of both series from the simulation's current state (rank 0 calls it; the
+    points and level sets are replicated). x0: {tag: initial point positions}."""
+    for b in sim.bodies:
+        pts = sim.points[b.tag]
+        data = {"stress": pts.stress, "volume": pts.vol, "displacement": pts.x - x0[b.tag]}
+        points_series.setdefault(b.name, Series(f"material_points_{b.name}")).add(step, pts.x, data)
+    nx, ny = len(sim.xlines), len(sim.ylines)
+    X, Y = np.meshgrid(sim.xlines, sim.ylines)
+    v = (np.arange(ny - 1)[:, None] * nx + np.arange(nx - 1)[None, :]).ravel()
+    quads = np.stack([v, v + 1, v + nx, v + nx + 1], axis=1)
+    data = {f"phi_{b.name}": sim.levelsets[b.tag].values.ravel() for b in sim.bodies}
+    for name, du in getattr(sim, "grid_increments", {}).items():
+        data[f"du_{name}"] = du
+    grid_series.add(step, np.stack([X.ravel(), Y.ravel()], axis=1), data, quads)
+
+
+@dataclass
+class StepRun:
+    """State of a multi-step run handed to the callbacks of `run_steps`."""
+
+    name: str
+    comm: object
+    metrics: dict
+    timer: PhaseTimer
+    sim: object = None
+    records: list = field(default_factory=list)  # ImplicitMPM.step records
+    rows: list = field(default_factory=list)  # steps.csv rows
+    data: dict = field(default_factory=dict)
+
+    @property
+    def params(self):
+        return self.metrics["parameters"]
+
+    @property
+    def results(self):
+        return self.metrics["results"]
+
+    @property
+    def analytic(self):
+        return self.metrics["analytic"]
+
+    @property
+    def problem_options(self):
+        """The ContactProblem keywords its parameters name (`demo.problem_options`: mu, eps0,
+        --petsc, --linear-solver, ...), for `ImplicitMPM`."""
+        return problem_options(self.params)
+
+
+def run_steps(
+    name,
+    params,
+    build,
+    num_steps,
+    row,
+    columns,
+    *,
+    evaluate=None,
+    plots=None,
+    summary=None,
+    series_every=10,
+    comm=None,
+    prog=None,
+):
+    """A multi-step demo (module docstring). build(run) -> ImplicitMPM (timed as "mesh" only
+    for what it does itself); row(run, record) -> the steps.csv row {column: value};
+    evaluate(run) on rank 0 fills results/analytic and solver warnings; plots(run, folder) on
+    rank 0. Returns the exit status."""
+    from mpi4py import MPI
+
+    from dolfinx_forms.io.folders import atomic_output_dir
+    from dolfinx_forms.io.results import write_metrics
+    from dolfinx_forms.solvers.checks import contact_warnings
+
+    comm = MPI.COMM_WORLD if comm is None else comm
+    prog = prog or Path(sys.argv[0]).name
+    metrics = new_metrics(name, "cut", params)
+    run = StepRun(name, comm, metrics, PhaseTimer(metrics))
+    points_series, grid_series = {}, Series("levelsets")
+    run.data["series"] = points_series  # {body name: Series} of the material points (rank 0)
+    checks = {}  # warning -> first step where it was seen
+    try:
+        run.sim = build(run)
+        x0 = None
+        for k in range(num_steps):
+            rec = run.sim.step()
+            run.records.append(rec)
+            for w in contact_warnings(run.sim.problem):
+                checks.setdefault(w, rec["step"])
+            run.rows.append(row(run, rec))
+            if x0 is None:  # positions at seeding: the first step's points before it moved
+                x0 = {
+                    t: p.x - d for (t, p), d in zip(run.sim.points.items(), run.sim.first_step_du)
+                }
+            if comm.rank == 0 and ((k + 1) % series_every == 0 or k + 1 == num_steps or k == 0):
+                add_frames(run.sim, points_series, grid_series, rec["step"], x0)
+    except (ContactSolverError, RuntimeError) as e:  # Newton, or the geometry of a step
+        if comm.rank == 0:
+            sys.stderr.write(f"{prog}: step {len(run.records) + 1}: {e}\n")
+        return 1
+    last = run.records[-1]
+    metrics["mesh"].update(
+        h_contact=run.sim.h, num_cells=last["num_cells"], num_dofs=last["num_dofs"]
+    )
+    metrics["solver"].update(
+        load_steps=len(run.records),
+        newton_iterations=[r["newton_iterations"] for r in run.records],
+        converged=True,
+        residual_history=[],
+        penalty={"eps_n": run.sim.problem.eps_n, "eps_t": run.sim.problem.eps_t},
+        linear_solver=run.sim.problem.linear.name,  # the last step's
+        condensed_dofs=int(getattr(run.sim.problem.linear, "num_dofs", 0)),
+        cutbacks=int(sum(r["cutbacks"] for r in run.records)),
+        warnings=[f"step {k}: {w}" for w, k in checks.items()],
+    )
+    if evaluate is not None and comm.rank == 0:
+        evaluate(run)
+    run.timer.stop()
+    run.metrics = metrics = comm.bcast(metrics if comm.rank == 0 else None, root=0)
+    contacts = [
+        dict(step=r["step"], **{c: p[c] for c in CONTACT_COLUMNS[1:]})
+        for r in run.records
+        for p in r["pairs"]
+    ]
+    bodies = [
+        dict(
+            step=r["step"],
+            body=b.name,
+            fx=r["body_forces"][b.name][0],
+            fy=r["body_forces"][b.name][1],
+            moment=r["body_forces"][b.name][2],
+            area_levelset=r["area_levelset"][b.name],
+            volume_points=r["volume_points"][b.name],
+        )
+        for r in run.records
+        for b in run.sim.bodies
+    ]
+    with atomic_output_dir(params["out"], comm, force=params.get("force", False)) as folder:
+        folder = Path(folder)
+        if comm.rank == 0:
+            write_csv(folder / "steps.csv", columns, run.rows)
+            write_csv(folder / "contacts.csv", CONTACT_COLUMNS, contacts)
+            write_csv(folder / "bodies.csv", BODY_COLUMNS, bodies)
+            for s in list(points_series.values()) + [grid_series]:
+                s.write(folder)
+            if plots is not None:
+                plots(run, folder)
+            write_metrics(folder, metrics)
+    if comm.rank == 0:
+        for w in metrics["solver"]["warnings"]:
+            print(f"WARNING: {w}")
+        if summary is not None:
+            print(summary(run) if callable(summary) else summary.format(**metrics))
+        print(f"results in {Path(params['out']).resolve()}")
+    return 0
+
+
+def binned_mean(x, values, size, max_bins=800):
+    """(image, extent) for imshow: the mean of `values` at the points x (n, 2) over square
+    pixels of side about `size` (at most max_bins across), NaN (blank) where no point falls."""
+    lo, hi = x.min(axis=0), x.max(axis=0)
+    n = np.clip(np.ceil((hi - lo) / size).astype(int), 1, max_bins)
+    rng = [(lo[0], lo[0] + max(hi[0] - lo[0], 1e-300)), (lo[1], lo[1] + max(hi[1] - lo[1], 1e-300))]
+    total, ex, ey = np.histogram2d(x[:, 0], x[:, 1], bins=n, range=rng, weights=values)
+    count = np.histogram2d(x[:, 0], x[:, 1], bins=n, range=rng)[0]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        image = np.where(count > 0, total / count, np.nan).T  # imshow: rows are y
+    return image, (ex[0], ex[-1], ey[0], ey[-1])
+
+
+def plot_force_chains(sim, record, path, title="force chains"):
+    """The force network of one step: segments from the centroids of the two bodies of every
+    pair with a normal force to the centre of its contact zone (width by normal force; a wall's
+    or obstacle's side is left out when its centroid lies far from the contact), over the mean
+    stress (s_xx + s_yy) / 2 at the material points (clipped at its 2nd percentile)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    centroid, radius = {}, {}
+    for b in sim.bodies:
+        p = sim.points[b.tag]
+        centroid[b.name] = np.average(p.x, axis=0, weights=p.vol)
+        radius[b.name] = np.sqrt(p.vol.sum() / np.pi)
+    fig, ax = plt.subplots(figsize=(6, 6))
+    x = np.concatenate([p.x for p in sim.points.values()])
+    mean = np.concatenate([0.5 * (p.stress[:, 0] + p.stress[:, 1]) for p in sim.points.values()])
+    lo = min(np.percentile(mean, 2), -1e-300)
+    # the points' mean per pixel of about h (4 points): a scatter of ~1e5 markers took 1-2 s
+    image, extent = binned_mean(x, mean, sim.h)
+    sc = ax.imshow(image, extent=extent, origin="lower", cmap="Greys_r", vmin=lo, vmax=0)
+    fmax = max([q["normal_force"] for q in record["pairs"]] + [1e-300])
+    for q in record["pairs"]:
+        if q["normal_force"] <= 0:
+            continue
+        c = np.array([q["x"], q["y"]])
+        lw = 0.5 + 5 * q["normal_force"] / fmax
+        # centroid -> contact for grain-like sides (a wall's centroid can be far away)
+        for name in (q["body_i"], q["body_j"]):
+            if name in centroid and np.linalg.norm(centroid[name] - c) < 1.5 * radius[name]:
+                a = centroid[name]
+                ax.plot([a[0], c[0]], [a[1], c[1]], "-", color="tab:red", lw=lw)
+    fig.colorbar(sc, ax=ax, label="mean stress (s_xx + s_yy)/2", shrink=0.8)
+    ax.set(aspect="equal", title=f"{title}, step {record['step']}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

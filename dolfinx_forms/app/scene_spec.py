@@ -1,0 +1,735 @@
+"""Scene descriptions: read, check and complete a TOML (or dict) description of a contact run.
+
+A description names the bodies (shape, law), the discretization, boundaries, conditions,
+load stages, outputs and checks; `runner.run` executes it. This module is pure Python: it
+reads and checks (one `SpecError` naming the key, e.g. ``bodies[1].shape.radius: must be > 0,
+got -1``) and returns the description with every default filled in, which metrics.json
+records as its parameters. Keys (defaults in brackets; "box" is [[x_min, y_min], [x_max, y_max]],
+an "expression" is a number or a string in x, y, z with + - * / **, pi and sqrt, sin, cos,
+tan, exp, log, abs):
+
+  name ["scene"; the file's stem], description [""], extends [none] (a description this one
+      changes: its tables merged key by key, anything else replaced)
+  [discretization]  kind = "cut" | "fitted", h (mesh size at the contact),
+      cut:    extent (box of the background grid), fine [none: uniform grid] (box where the
+              spacing is h, widened to the multiples of h), growth [1.2], h_far [no cap];
+              uniform grids: cells [extent / h, rounded] = [n_x, n_y]
+      fitted: cell ["triangle" | "quadrilateral"], degree [1], fine [the contact box], h_far
+              [8 h], slope [0.25] (gmsh size growth per unit distance from `fine`),
+              structured [false] (boxes without a window: transfinite grids of about h)
+      both:   contact_box [the pairs' overlaps] (cells owned by MPI rank 0)
+  [solver]  enforcement ["penalty" | "augmented"], multiplier_mass ["hybrid" | "consistent" |
+      "lumped": augmented only, see ContactProblem], eps0 [1.0; augmented 1e-2: the loop's
+      speed only], band [2 h], mu [0.0], ghost_penalty [0.01], grid_refine [4],
+      num_gauss [2], steps [1], quadrature_degree, cut_degree [4], linear_solver ["auto"]
+      ("condensed", "factorised", "iterative": dolfinx_forms/solvers/linear.py), petsc {KEY =
+      VALUE}, newton {rtol, ftol, atol, stol, max_iterations, max_cutbacks}
+  [[bodies]]  name, shape = {type = "circle", centre, radius} | {type = "ellipse", centre,
+      axes = [a, b], angle [0, degrees]} | {type = "box", min, max} | {type = "polygon",
+      points | file (x, y per line)} | {type = "half_plane", point, normal (outward)},
+      law = {type = "linear", E, nu} | {type = "orthotropic", E1, E2, E3, nu12, nu13, nu23,
+      G12, angle [0, degrees]} | {type = "neo-hookean", E, nu}, window [cut: the shape's box
+      on grid lines] (the body is shape ∩ window; cut: window sides are grid lines)
+  [[pairs]]  bodies = [name_i, name_j]       [every pair of bodies]
+  [[boundaries]]  name, and side = "bottom" | [sides] of `body`'s window (cut) or bounding
+      box (fitted), or box = {x_min, x_max, y_min, y_max} (facets inside, of `body` if given)
+  [[dirichlet]]  name [boundary.component], boundary | point = [x, y], component ["all" |
+      "x" | "y" | "z"], value [0] (expression: a value per dof)
+  [[tractions]]  name [boundary], boundary, value = [expressions], scale [1]
+  [[body_forces]]  name, body [every body], value = [expressions], scale [1]
+  [[stages]]  label [kind-i], kind = "ramp": to = {load name = target} [every load to its
+      value / scale], steps [solver.steps] | kind = "force": dirichlet, boundary [its],
+      component [its], target, first_guess, tol [1e-3], max_iter [12], monotone [false],
+      steps [1] | kind = "friction": mu.          [one ramp of every load]
+      Every load starts at 0 (tractions: scale 0) and moves only in the stages.
+  [outputs]  tractions [true], solution [true], plot [true], reaction [the first Dirichlet
+      boundary] (results.reaction)
+  [analytic]  type = "hertz": R, bodies [the first pair], normal_force = {boundary,
+      component}, tangential_force [none] | type = "patch": displacement, height, body
+  [[checks]]  quantity (a metrics path, e.g. "results.reaction[1]"), and close_to (number or
+      path) with rtol / atol, below, above; label [quantity]
+"""
+
+from __future__ import annotations
+
+import ast
+import copy
+import math
+import tomllib
+from pathlib import Path
+
+from dolfinx_forms.common import SpecError  # noqa: F401  (raised here; its home is common)
+
+__all__ = ["SpecError", "load", "validate", "apply_overrides", "parse_expression", "SIDES"]
+
+SIDES = ("left", "right", "bottom", "top")
+COMPONENTS = {"x": 0, "y": 1, "z": 2}
+LAW_PARAMETERS = {  # type -> (required, optional with defaults); laws.LAWS builds them
+    "linear": (("E", "nu"), {}),
+    "orthotropic": (("E1", "E2", "E3", "nu12", "nu13", "nu23", "G12"), {"angle": 0.0}),
+    "neo-hookean": (("E", "nu"), {}),
+}
+BOUNDS = {"nu": dict(lo=-1, hi=0.5, lo_open=True, hi_open=True)}  # others: moduli > 0
+BOUNDS.update({k: dict(lo=0, lo_open=True) for k in ("E", "E1", "E2", "E3", "G12")})
+SHAPES = {  # type -> (required, optional with defaults)
+    "circle": (("centre", "radius"), {}),
+    "ellipse": (("centre", "axes"), {"angle": 0.0}),
+    "box": (("min", "max"), {}),
+    "polygon": ((), {"points": None, "file": None}),
+    "half_plane": (("point", "normal"), {}),
+}
+CHECK_ROOTS = ("results", "analytic", "solver", "mesh", "timing_s")
+FUNCTIONS = ("sqrt", "sin", "cos", "tan", "exp", "log", "abs")
+_REQUIRED = object()
+
+
+# --------------------------------------------------------------------------- values
+def _number(v, key, lo=None, hi=None, lo_open=False, hi_open=False, integer=False):
+    ok = isinstance(v, int) if integer else isinstance(v, (int, float))
+    if isinstance(v, bool) or not ok or not math.isfinite(v):
+        raise SpecError(key, f"must be {'an integer' if integer else 'a number'}, got {v!r}")
+    if lo is not None and (v <= lo if lo_open else v < lo):
+        raise SpecError(key, f"must be {'>' if lo_open else '>='} {lo}, got {v}")
+    if hi is not None and (v >= hi if hi_open else v > hi):
+        raise SpecError(key, f"must be {'<' if hi_open else '<='} {hi}, got {v}")
+    return int(v) if integer else float(v)
+
+
+def _point(v, key):
+    if not isinstance(v, list) or len(v) not in (2, 3):
+        raise SpecError(key, f"must be a point [x, y], got {v!r}")
+    return [_number(c, f"{key}[{i}]") for i, c in enumerate(v)]
+
+
+def _box(v, key):
+    if not isinstance(v, list) or len(v) != 2:
+        raise SpecError(key, f"must be a box [[x_min, y_min], [x_max, y_max]], got {v!r}")
+    lo, hi = _point(v[0], f"{key}[0]"), _point(v[1], f"{key}[1]")
+    if len(lo) != len(hi) or not all(a < b for a, b in zip(lo, hi)):
+        raise SpecError(key, f"needs min < max in every coordinate, got {v!r}")
+    return [lo, hi]
+
+
+def parse_expression(text, key, names=("x", "y", "z")):
+    """Check an expression (number or string) and return it (a float or the string)."""
+    if not isinstance(text, str):
+        return _number(text, key)
+    try:
+        tree = ast.parse(text, mode="eval")
+    except SyntaxError:
+        raise SpecError(key, f"not an expression: {text!r}") from None
+    allowed = set(names) | set(FUNCTIONS) | {"pi"}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name) and node.id not in allowed:
+            raise SpecError(
+                key,
+                f"unknown name {node.id!r} in {text!r} (allowed: {', '.join(sorted(allowed))})",
+            )
+        if isinstance(node, ast.Call) and not (
+            isinstance(node.func, ast.Name) and node.func.id in FUNCTIONS
+        ):
+            raise SpecError(key, f"only {', '.join(FUNCTIONS)} may be called in {text!r}")
+        if not isinstance(
+            node,
+            (
+                ast.Expression,
+                ast.BinOp,
+                ast.UnaryOp,
+                ast.Constant,
+                ast.Name,
+                ast.Call,
+                ast.Load,
+                ast.operator,
+                ast.unaryop,
+            ),
+        ):
+            raise SpecError(key, f"unsupported syntax in {text!r}")
+        if isinstance(node, ast.Constant) and not isinstance(node.value, (int, float)):
+            raise SpecError(key, f"only numbers are allowed in {text!r}")
+    return text
+
+
+class _Table:
+    """One table of the description: typed reads with defaults, unknown keys refused."""
+
+    def __init__(self, data, key):
+        if not isinstance(data, dict):
+            raise SpecError(key, f"must be a table, got {data!r}")
+        self.data, self.key, self.used = data, key, set()
+
+    def path(self, k):
+        return f"{self.key}.{k}" if self.key else k
+
+    def has(self, k):
+        return k in self.data
+
+    def raw(self, k, default=_REQUIRED):
+        self.used.add(k)
+        if k not in self.data:
+            if default is _REQUIRED:
+                raise SpecError(self.path(k), "missing")
+            return default
+        return self.data[k]
+
+    def number(self, k, default=_REQUIRED, **bounds):
+        if k not in self.data:
+            return self.raw(k, default)
+        return _number(self.raw(k), self.path(k), **bounds)
+
+    def integer(self, k, default=_REQUIRED, **bounds):
+        return self.number(k, default, integer=True, **bounds)
+
+    def string(self, k, default=_REQUIRED, choices=None):
+        if k not in self.data:
+            return self.raw(k, default)
+        v = self.raw(k)
+        if not isinstance(v, str):
+            raise SpecError(self.path(k), f"must be a string, got {v!r}")
+        if choices is not None and v not in choices:
+            raise SpecError(
+                self.path(k), f"must be one of {', '.join(map(repr, choices))}, got {v!r}"
+            )
+        return v
+
+    def boolean(self, k, default=_REQUIRED):
+        v = self.raw(k, default)
+        if not isinstance(v, bool):
+            raise SpecError(self.path(k), f"must be true or false, got {v!r}")
+        return v
+
+    def box(self, k, default=_REQUIRED):
+        v = self.raw(k, default)
+        return v if v is None else _box(v, self.path(k))
+
+    def point(self, k, default=_REQUIRED):
+        v = self.raw(k, default)
+        return v if v is None else _point(v, self.path(k))
+
+    def table(self, k, default=_REQUIRED):
+        v = self.raw(k, default)
+        return None if v is None else _Table(v, self.path(k))
+
+    def tables(self, k):
+        v = self.raw(k, [])
+        if not isinstance(v, list):
+            raise SpecError(self.path(k), f"must be an array of tables ([[{k}]]), got {v!r}")
+        return [_Table(item, f"{self.path(k)}[{i}]") for i, item in enumerate(v)]
+
+    def done(self):
+        unknown = set(self.data) - self.used
+        if unknown:
+            k = sorted(unknown)[0]
+            known = ", ".join(sorted(self.used))
+            raise SpecError(self.path(k), f"unknown key (expected one of: {known})")
+
+
+def _name(t, k, names, what, default=_REQUIRED):
+    """A reference to one of `names` (e.g. a body name)."""
+    v = t.string(k, default)
+    if v is not None and v not in names:
+        raise SpecError(t.path(k), f"unknown {what} {v!r} (known: {', '.join(names) or 'none'})")
+    return v
+
+
+def _component(t, k, default):
+    v = t.raw(k, default)
+    if v in ("all", None):
+        return "all"
+    if isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 2:
+        return "xyz"[v]
+    if v not in COMPONENTS:
+        raise SpecError(t.path(k), f"must be one of 'x', 'y', 'z', 'all', got {v!r}")
+    return v
+
+
+# --------------------------------------------------------------------------- sections
+def _discretization(t):
+    kind = t.string("kind", choices=("cut", "fitted"))
+    d = {"kind": kind, "h": t.number("h", lo=0, lo_open=True)}
+    if kind == "cut":
+        d["extent"] = t.box("extent")
+        d["fine"] = t.box("fine", None)
+        d["growth"] = t.number("growth", 1.2, lo=1)
+        d["h_far"] = t.number("h_far", None, lo=0, lo_open=True)
+        cells = t.raw("cells", None)
+        if cells is not None:
+            if not isinstance(cells, list) or len(cells) != len(d["extent"][0]):
+                raise SpecError(t.path("cells"), f"must be [n_x, n_y], got {cells!r}")
+            cells = [_number(n, f"{t.path('cells')}[{i}]", lo=1, integer=True)
+                     for i, n in enumerate(cells)]  # fmt: skip
+            if d["fine"] is not None:
+                raise SpecError(t.path("cells"), "is for uniform grids (no `fine`)")
+        d["cells"] = cells
+        if t.string("cell", "quadrilateral") != "quadrilateral":
+            raise SpecError(t.path("cell"), "the cut grid is made of quadrilaterals")
+        if t.integer("degree", 1) != 1:
+            raise SpecError(t.path("degree"), "the cut discretization supports degree 1 only")
+        other = ("slope", "structured")
+    else:
+        d["cell"] = t.string("cell", "triangle", choices=("triangle", "quadrilateral"))
+        d["degree"] = t.integer("degree", 1, lo=1, hi=2)
+        d["fine"] = t.box("fine", None)
+        d["h_far"] = t.number("h_far", 8 * d["h"], lo=0, lo_open=True)
+        d["slope"] = t.number("slope", 0.25, lo=0, lo_open=True)
+        d["structured"] = t.boolean("structured", False)
+        other = ("extent", "growth")
+    d["contact_box"] = t.box("contact_box", None)
+    for k in other:
+        if t.has(k):
+            raise SpecError(t.path(k), f"not used by kind = {kind!r}")
+    t.done()
+    return d
+
+
+def _solver(t):
+    from dolfinx_forms.app.cli import AUGMENTED_EPS0
+
+    enforcement = t.string("enforcement", "penalty", choices=["penalty", "augmented"])
+    from dolfinx_forms.geometry.pairs import DEFAULT_MULTIPLIER_MASS, MULTIPLIER_MASSES
+
+    mass = t.string("multiplier_mass", None, choices=list(MULTIPLIER_MASSES))
+    if mass is not None and enforcement != "augmented":
+        raise SpecError(
+            t.path("multiplier_mass"), 'needs enforcement = "augmented" (the penalty has none)'
+        )
+    # augmented: eps0 sets only the Uzawa loop's speed (the demos' --eps0 default likewise)
+    eps0 = 1.0 if enforcement == "penalty" else AUGMENTED_EPS0
+    s = dict(
+        enforcement=enforcement,
+        multiplier_mass=mass or (DEFAULT_MULTIPLIER_MASS if enforcement == "augmented" else None),
+        eps0=t.number("eps0", eps0, lo=0, lo_open=True),
+        band=t.number("band", None, lo=0, lo_open=True),
+        mu=t.number("mu", 0.0, lo=0),
+        ghost_penalty=t.number("ghost_penalty", 0.01, lo=0),
+        grid_refine=t.integer("grid_refine", 4, lo=1, hi=16),
+        num_gauss=t.integer("num_gauss", 2, lo=1, hi=5),
+        steps=t.integer("steps", 1, lo=1, hi=1000),
+        quadrature_degree=t.integer("quadrature_degree", None, lo=1, hi=20),
+        cut_degree=t.integer("cut_degree", 4, lo=1, hi=20),
+        linear_solver=t.string(
+            "linear_solver", "auto", choices=["auto", "condensed", "factorised", "iterative"]
+        ),
+    )
+    petsc = t.table("petsc", {})
+    s["petsc"] = {}
+    for k, v in petsc.data.items():
+        if isinstance(v, (dict, list)):
+            raise SpecError(petsc.path(k), f"must be a string or a number, got {v!r}")
+        s["petsc"][k] = str(v).lower() if isinstance(v, bool) else str(v)
+    newton = t.table("newton", {})
+    s["newton"] = {
+        k: newton.number(k, None, lo=0, lo_open=True) for k in ("rtol", "ftol", "atol", "stol")
+    }
+    s["newton"].update(
+        {
+            k: newton.integer(k, None, lo=lo)
+            for k, lo in (("max_iterations", 1), ("max_cutbacks", 0))
+        }
+    )
+    s["newton"] = {k: v for k, v in s["newton"].items() if v is not None}
+    newton.done()
+    t.done()
+    return s
+
+
+def _shape(t, base_dir):
+    kind = t.string("type", choices=tuple(SHAPES))
+    s = {"type": kind}
+    if kind == "circle":
+        s.update(centre=t.point("centre"), radius=t.number("radius", lo=0, lo_open=True))
+    elif kind == "ellipse":
+        s.update(centre=t.point("centre"), angle=t.number("angle", 0.0))
+        axes = t.raw("axes")
+        if not isinstance(axes, list) or len(axes) != 2:
+            raise SpecError(t.path("axes"), f"must be [a, b], got {axes!r}")
+        s["axes"] = [
+            _number(a, f"{t.path('axes')}[{i}]", lo=0, lo_open=True) for i, a in enumerate(axes)
+        ]
+    elif kind == "box":
+        s["min"], s["max"] = _box([t.raw("min"), t.raw("max")], t.key)
+    elif kind == "polygon":
+        pts, file = t.raw("points", None), t.string("file", None)
+        if (pts is None) == (file is None):
+            raise SpecError(t.path("points"), "give exactly one of points and file")
+        if file is not None:
+            path = Path(base_dir or ".") / file
+            try:
+                rows = [ln.replace(",", " ").split() for ln in path.read_text().splitlines()]
+                pts = [[float(c) for c in r] for r in rows if r and not r[0].startswith("#")]
+            except (OSError, ValueError) as e:
+                raise SpecError(t.path("file"), f"cannot read points from {path}: {e}") from None
+            s["file"] = file
+        if not isinstance(pts, list) or len(pts) < 3:
+            raise SpecError(
+                t.path("points" if file is None else "file"), "a polygon needs at least 3 points"
+            )
+        s["points"] = [_point(p, f"{t.path('points')}[{i}]") for i, p in enumerate(pts)]
+    else:
+        s.update(point=t.point("point"), normal=t.point("normal"))
+        if not any(s["normal"]):
+            raise SpecError(t.path("normal"), "must not be zero")
+    t.done()
+    return s
+
+
+def make_law(law):
+    """The solver material of a checked law description: the one place where a description
+    becomes a `laws.Law` (angles in the description are in degrees)."""
+    from dolfinx_forms.fem.laws import LAWS
+
+    params = {k: v for k, v in law.items() if k != "type"}
+    if "angle" in params:
+        params["angle"] = math.radians(params["angle"])
+    return LAWS[law["type"]](**params)
+
+
+def _law(t):
+    kind = t.string("type", choices=tuple(LAW_PARAMETERS))
+    required, optional = LAW_PARAMETERS[kind]
+    law = {
+        "type": kind,
+        **{k: t.number(k, **BOUNDS.get(k, {})) for k in required},
+        **{k: t.number(k, v) for k, v in optional.items()},
+    }
+    t.done()
+    try:
+        make_law(law)
+    except ValueError as e:
+        raise SpecError(t.key, str(e)) from None
+    return law
+
+
+def _stage(t, i, loads, dirichlet, boundaries, default_steps):
+    kind = t.string("kind", choices=("ramp", "force", "friction"))
+    st = {"kind": kind, "label": t.string("label", f"{kind}-{i}")}
+    if kind == "ramp":
+        to = t.table("to", None)
+        if to is not None:
+            st["to"] = {}
+            for k, v in to.data.items():
+                if k not in loads:
+                    raise SpecError(to.path(k), f"unknown load (known: {', '.join(loads)})")
+                if loads[k] != "dirichlet" and isinstance(v, str):
+                    raise SpecError(
+                        to.path(k), "a traction or body force target is a number (its scale)"
+                    )
+                st["to"][k] = parse_expression(v, to.path(k))
+        else:
+            st["to"] = None
+        st["steps"] = t.integer("steps", default_steps, lo=1, hi=1000)
+    elif kind == "force":
+        name = _name(t, "dirichlet", list(dirichlet), "Dirichlet condition")
+        bc = dirichlet[name]
+        st.update(
+            dirichlet=name,
+            boundary=_name(t, "boundary", boundaries, "boundary", bc.get("boundary")),
+        )
+        if st["boundary"] is None:
+            raise SpecError(t.path("boundary"), "missing (the condition is on a point)")
+        st["component"] = _component(t, "component", bc["component"])
+        if st["component"] == "all" or bc["component"] not in ("all", st["component"]):
+            raise SpecError(
+                t.path("component"), f"must be the component the condition {name!r} prescribes"
+            )
+        if isinstance(bc["value"], str):
+            raise SpecError(
+                t.path("dirichlet"),
+                f"{name!r} has a per-dof value: force control moves one value",
+            )
+        st.update(
+            target=t.number("target"),
+            first_guess=t.number("first_guess"),
+            tol=t.number("tol", 1e-3, lo=0, lo_open=True),
+            max_iter=t.integer("max_iter", 12, lo=1, hi=1000),
+            monotone=t.boolean("monotone", False),
+            steps=t.integer("steps", 1, lo=1, hi=1000),
+        )
+        if st["target"] == 0:
+            raise SpecError(t.path("target"), "must not be 0 (the tolerance is relative)")
+    else:
+        st["mu"] = t.number("mu", lo=0)
+    t.done()
+    return st
+
+
+def _force_ref(t, k, boundaries, default=_REQUIRED):
+    r = t.table(k, default)
+    if r is None:
+        return None
+    out = {
+        "boundary": _name(r, "boundary", boundaries, "boundary"),
+        "component": _component(r, "component", _REQUIRED),
+    }
+    if out["component"] == "all":
+        raise SpecError(r.path("component"), "must be 'x', 'y' or 'z'")
+    r.done()
+    return out
+
+
+def _analytic(t, bodies, pairs, boundaries):
+    kind = t.string("type", choices=("hertz", "patch"))
+    a = {"type": kind}
+    if kind == "hertz":
+        a["R"] = t.number("R", lo=0, lo_open=True)
+        names = t.raw("bodies", list(pairs[0]) if pairs else None)
+        if not isinstance(names, list) or len(names) != 2 or any(n not in bodies for n in names):
+            raise SpecError(t.path("bodies"), f"must be two body names, got {names!r}")
+        a["bodies"] = names
+        a["normal_force"] = _force_ref(t, "normal_force", boundaries)
+        a["tangential_force"] = _force_ref(t, "tangential_force", boundaries, None)
+    else:
+        a.update(
+            displacement=t.number("displacement", lo=0, lo_open=True),
+            height=t.number("height", lo=0, lo_open=True),
+            body=_name(t, "body", list(bodies), "body", next(iter(bodies))),
+        )
+    for name in a.get("bodies", [a.get("body")]):
+        if bodies[name]["law"]["type"] != "linear":
+            raise SpecError(t.path("type"), f"the {kind} reference needs linear laws ({name!r})")
+    t.done()
+    return a
+
+
+def _path_or_number(t, k):
+    v = t.raw(k, None)
+    if v is None or not isinstance(v, str):
+        return v if v is None else _number(v, t.path(k))
+    _metric_path(v, t.path(k))
+    return v
+
+
+def _metric_path(v, key):
+    root = v.split(".")[0].split("[")[0]
+    if not isinstance(v, str) or root not in CHECK_ROOTS:
+        raise SpecError(
+            key,
+            f"must be a metrics path starting with one of {', '.join(CHECK_ROOTS)}, got {v!r}",
+        )
+    return v
+
+
+def _check(t):
+    c = {"quantity": _metric_path(t.string("quantity"), t.path("quantity"))}
+    c["label"] = t.string("label", c["quantity"])
+    for k in ("close_to", "below", "above"):
+        c[k] = _path_or_number(t, k)
+    c["rtol"] = t.number("rtol", None, lo=0)
+    c["atol"] = t.number("atol", None, lo=0)
+    if c["close_to"] is None and c["below"] is None and c["above"] is None:
+        raise SpecError(t.key, "give close_to (with rtol or atol), below or above")
+    if c["close_to"] is not None and c["rtol"] is None and c["atol"] is None:
+        raise SpecError(t.path("close_to"), "needs rtol or atol")
+    t.done()
+    return c
+
+
+# --------------------------------------------------------------------------- the description
+def validate(data, base_dir=None, default_name="scene"):
+    """Check a description (a dict, as read from TOML) and return a new dict with every
+    default filled in. Raises SpecError naming the first bad key."""
+    top = _Table(copy.deepcopy(data), "")
+    spec = {"name": top.string("name", default_name), "description": top.string("description", "")}
+    spec["discretization"] = _discretization(top.table("discretization"))
+    spec["solver"] = _solver(top.table("solver", {}))
+
+    bodies = {}
+    for i, b in enumerate(top.tables("bodies")):
+        name = b.string("name")
+        if name in bodies:
+            raise SpecError(b.path("name"), f"duplicate body name {name!r}")
+        bodies[name] = {
+            "name": name,
+            "shape": _shape(b.table("shape"), base_dir),
+            "law": _law(b.table("law")),
+            "window": b.box("window", None),
+        }
+        if bodies[name]["shape"]["type"] == "half_plane" and bodies[name]["window"] is None:
+            raise SpecError(b.path("window"), "a half_plane body needs a window")
+        b.done()
+    if not bodies:
+        raise SpecError("bodies", "missing (at least one [[bodies]] table)")
+    names = list(bodies)
+    spec["bodies"] = list(bodies.values())
+
+    pairs = []
+    for p in top.tables("pairs"):
+        v = p.raw("bodies")
+        if (
+            not isinstance(v, list)
+            or len(v) != 2
+            or v[0] == v[1]
+            or any(n not in bodies for n in v)
+        ):
+            raise SpecError(p.path("bodies"), f"must be two different body names, got {v!r}")
+        pairs.append(list(v))
+        p.done()
+    if not top.has("pairs"):
+        pairs = [[a, b] for i, a in enumerate(names) for b in names[i + 1 :]]
+    spec["pairs"] = pairs
+
+    boundaries = {}
+    for b in top.tables("boundaries"):
+        name = b.string("name")
+        if name in boundaries:
+            raise SpecError(b.path("name"), f"duplicate boundary name {name!r}")
+        bd = {"name": name, "body": _name(b, "body", names, "body", None)}
+        if b.has("side") == b.has("box"):
+            raise SpecError(b.path("side"), "give exactly one of side and box")
+        if b.has("side"):
+            sides = b.raw("side")
+            sides = [sides] if isinstance(sides, str) else sides
+            if not isinstance(sides, list) or not sides or any(s not in SIDES for s in sides):
+                raise SpecError(
+                    b.path("side"),
+                    f"must be one or more of {', '.join(SIDES)}, got {b.raw('side')!r}",
+                )
+            if bd["body"] is None:
+                raise SpecError(b.path("body"), "missing (side is a side of a body)")
+            bd["side"] = sides
+        else:
+            box = b.table("box")
+            bd["box"] = {
+                k: box.number(k, None)
+                for k in ("x_min", "x_max", "y_min", "y_max", "z_min", "z_max")
+            }
+            box.done()
+        boundaries[name] = bd
+        b.done()
+    spec["boundaries"] = list(boundaries.values())
+    bnames = list(boundaries)
+
+    loads, dirichlet = {}, {}
+
+    def add_load(t, entry, kind):
+        if entry["name"] in loads:
+            raise SpecError(t.path("name"), f"duplicate load name {entry['name']!r}")
+        loads[entry["name"]] = kind
+        t.done()
+        return entry
+
+    spec["dirichlet"] = []
+    for t in top.tables("dirichlet"):
+        if t.has("boundary") == t.has("point"):
+            raise SpecError(t.path("boundary"), "give exactly one of boundary and point")
+        d = {
+            "boundary": _name(t, "boundary", bnames, "boundary", None),
+            "point": t.point("point", None),
+            "component": _component(t, "component", "all"),
+        }
+        d["value"] = parse_expression(t.raw("value", 0.0), t.path("value"))
+        d["name"] = t.string("name", f"{d['boundary'] or 'point'}.{d['component']}")
+        dirichlet[d["name"]] = d
+        spec["dirichlet"].append(add_load(t, d, "dirichlet"))
+    for section, where in (("tractions", "boundary"), ("body_forces", "body")):
+        spec[section] = []
+        for t in top.tables(section):
+            ref = (
+                _name(t, "boundary", bnames, "boundary")
+                if where == "boundary"
+                else _name(t, "body", names, "body", None)
+            )
+            value = t.raw("value")
+            if not isinstance(value, list) or len(value) not in (2, 3):
+                raise SpecError(t.path("value"), f"must be a vector [f_x, f_y], got {value!r}")
+            e = {
+                where: ref,
+                "value": [
+                    parse_expression(v, f"{t.path('value')}[{i}]") for i, v in enumerate(value)
+                ],
+                "scale": t.number("scale", 1.0),
+            }
+            e["name"] = t.string("name", ref if ref is not None else f"{section}-{len(loads)}")
+            spec[section].append(add_load(t, e, section))
+
+    stages = top.tables("stages")
+    spec["stages"] = [
+        _stage(s, i, loads, dirichlet, bnames, spec["solver"]["steps"])
+        for i, s in enumerate(stages, start=1)
+    ]
+    if not stages:
+        spec["stages"] = [
+            {"kind": "ramp", "label": "load", "to": None, "steps": spec["solver"]["steps"]}
+        ]
+
+    out = top.table("outputs", {})
+    first = next((d["boundary"] for d in spec["dirichlet"] if d["boundary"]), None)
+    spec["outputs"] = {k: out.boolean(k, True) for k in ("tractions", "solution", "plot")}
+    spec["outputs"]["reaction"] = _name(out, "reaction", bnames, "boundary", first)
+    out.done()
+    an = top.table("analytic", None)
+    spec["analytic"] = None if an is None else _analytic(an, bodies, pairs, bnames)
+    spec["checks"] = [_check(c) for c in top.tables("checks")]
+    top.done()
+    return spec
+
+
+def apply_overrides(data, overrides):
+    """Set values given as 'a.b[1].c=VALUE' (VALUE in TOML syntax, or a bare string) in a copy
+    of `data`; tables on the way are created."""
+    data = copy.deepcopy(data)
+    for item in overrides:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise SpecError("--set", f"expected KEY=VALUE, got {item!r}")
+        try:
+            value = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = text.strip()
+        parts = [p for p in key.replace("[", ".").replace("]", "").split(".") if p]
+        node = data
+        for i, p in enumerate(parts):
+            last = i == len(parts) - 1
+            if isinstance(node, list):
+                if not p.isdigit() or int(p) >= len(node):
+                    raise SpecError(key, f"no item {p!r} in the array of {len(node)}")
+                p = int(p)
+            elif not isinstance(node, dict):
+                raise SpecError(key, f"{'.'.join(parts[:i])} is not a table")
+            if last:
+                node[p] = value
+            else:
+                if isinstance(node, dict) and p not in node:
+                    node[p] = {}
+                node = node[p]
+    return data
+
+
+def _merge(base, over):
+    """`over` on top of `base`: tables merged key by key, anything else (arrays of tables
+    included) replaced."""
+    out = dict(base)
+    for k, v in over.items():
+        out[k] = _merge(base[k], v) if isinstance(v, dict) and isinstance(base.get(k), dict) else v
+    return out
+
+
+def _read(path, seen=()):
+    """A TOML file as a dict, with `extends = "other.toml"` (relative to the file) resolved."""
+    path = Path(path)
+    try:
+        with open(path, "rb") as f:
+            data = tomllib.load(f)
+    except OSError as e:
+        raise SpecError(str(path), f"cannot read the description ({e.strerror})") from None
+    except tomllib.TOMLDecodeError as e:
+        raise SpecError(str(path), f"not valid TOML ({e})") from None
+    base = data.pop("extends", None)
+    if base is None:
+        return data
+    if not isinstance(base, str):
+        raise SpecError("extends", f"must be a file name, got {base!r}")
+    base = path.parent / base
+    if base.resolve() in seen:
+        raise SpecError("extends", f"{base} extends itself")
+    return _merge(_read(base, (*seen, path.resolve())), data)
+
+
+def load(source, overrides=()):
+    """A checked description from a TOML file path or a dict (see the module docstring)."""
+    if isinstance(source, dict):
+        return validate(apply_overrides(source, overrides))
+    path = Path(source)
+    return validate(
+        apply_overrides(_read(path), overrides), base_dir=path.parent, default_name=path.stem
+    )

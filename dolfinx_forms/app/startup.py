@@ -1,0 +1,106 @@
+"""Process start-up of the application (demos, `python3 -m dolfinx_forms`, the scene runner):
+settings that make a run start faster or end cleanly, made once, before MPI, UFL and FFCx are
+imported. The library itself (`import dolfinx_forms`) does none of this.
+
+`start()`:
+* an early plotting worker for a demo (io/plot_worker.py: matplotlib's import overlaps ours);
+* Open MPI singleton settings (no helper daemon, no transport probing: ~0.6 s of a
+  singleton's start), removed from the environment again after MPI_Init;
+* one OpenBLAS thread per MPI rank under mpirun (the ranks already share the cores);
+* UFL's and FFCx's version look-up without scanning every installed distribution;
+* quiet JIT loggers (app/logs.py) and, under mpirun, an error on one rank ends every rank
+  (app/mpi_errors.py).
+"""
+
+import os
+import sys
+
+def _setup_mpi():
+    """Quiet JIT loggers (logs.py) and, under mpirun, an error on one rank ends every rank
+    (mpi_errors.py)."""
+    from dolfinx_forms.app import logs
+
+    logs.configure()
+    # A singleton's only peer is itself, yet Open MPI's default point-to-point layer (UCX) and
+    # transports (TCP, shared memory) probe the machine for ~0.2 s in MPI_Init. The setting
+    # is read by MPI_Init only and removed after it: an mpirun started from this process must
+    # not inherit btl=self. A launched process (mpirun, srun, hydra) keeps the defaults.
+    launched = ("OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE", "SLURM_PROCID")
+    singleton = {"OMPI_MCA_pml": "ob1", "OMPI_MCA_btl": "self"}
+    if "mpi4py.MPI" in sys.modules or any(k in os.environ for k in launched + (*singleton,)):
+        singleton = {}
+    os.environ.update(singleton)
+    try:
+        from mpi4py import MPI
+    finally:
+        for k in singleton:
+            del os.environ[k]
+
+    if MPI.COMM_WORLD.size > 1:
+        from dolfinx_forms.app import mpi_errors
+
+        mpi_errors.install()
+
+
+def _import_ufl_ffcx():
+    """Debian's ufl and ffcx (2022.2, 0.5) read their own version at import with pkg_resources,
+    which scans every installed distribution (0.1 s, a third of importing dolfinx). These two
+    imports see a stand-in whose get_distribution answers from the name of the distribution's
+    .dist-info folder on sys.path (importlib.metadata, itself 0.04 s to import, where there is
+    none), the same version string; pkg_resources itself stays importable (the stand-in is
+    removed after)."""
+    if any(m in sys.modules for m in ("pkg_resources", "ufl", "ffcx")):
+        return
+    import types
+
+    def version(name):
+        prefix = name.replace("-", "_").lower() + "-"
+        for folder in sys.path:
+            try:
+                entries = os.listdir(folder or ".")
+            except OSError:
+                continue
+            for e in entries:
+                if e.endswith(".dist-info") and e.lower().startswith(prefix):
+                    return e[len(prefix) : -len(".dist-info")]
+        import importlib.metadata
+
+        return importlib.metadata.version(name)
+
+    def get_distribution(name):
+        return types.SimpleNamespace(version=version(name))
+
+    sys.modules["pkg_resources"] = types.ModuleType("pkg_resources", "ufl/ffcx stand-in")
+    sys.modules["pkg_resources"].get_distribution = get_distribution
+    try:
+        import ffcx  # noqa: F401
+        import ufl  # noqa: F401
+    finally:
+        del sys.modules["pkg_resources"]
+
+
+
+
+
+
+_started = False
+
+
+def start():
+    """The application's start-up (module doc); once per process, later calls do nothing."""
+    global _started
+    if _started:
+        return
+    _started = True
+    from dolfinx_forms.io import plot_worker
+
+    plot_worker.start_early()
+    # A process started without mpirun is an Open MPI singleton: by default its MPI_Init starts
+    # a helper daemon (for MPI_Comm_spawn, which this code never calls), ~0.4 s of every run's
+    # start. Under mpirun the setting has no effect; a user's own value is kept.
+    os.environ.setdefault("OMPI_MCA_ess_singleton_isolated", "1")
+    # OpenBLAS starts a thread per core; MPI ranks already share the cores.
+    if int(os.environ.get("OMPI_COMM_WORLD_SIZE", "1")) > 1:
+        os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    _import_ufl_ffcx()
+    _setup_mpi()

@@ -1,0 +1,132 @@
+"""Demo outputs: tractions.csv, XDMF, traction plots (atomic folders: results.py)."""
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from dolfinx_forms.contact.contact_set import STATE_NAMES
+from dolfinx_forms.io import plot_worker
+from dolfinx_forms.io.results import write_metrics
+
+TRACTION_COLUMNS = ("x", "y", "p_n", "p_t", "gap_n", "slip", "state")
+
+
+def gather_points(problem):
+    """All ranks' contact points on rank 0, sorted by x (None on other ranks)."""
+    local = problem.contact_points()
+    keys = ("x", "y", "w", "p_n", "p_t", "gap_n", "slip", "state")
+    mine = {k: np.concatenate([p[k] for p in local]) if local else np.zeros(0) for k in keys}
+    allp = problem.comm.gather(mine, root=0)
+    if problem.comm.rank != 0:
+        return None
+    pts = {k: np.concatenate([p[k] for p in allp]) for k in keys}
+    order = np.argsort(pts["x"], kind="stable")
+    return {k: v[order] for k, v in pts.items()}
+
+
+def write_tractions(folder, pts):
+    with open(Path(folder) / "tractions.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(TRACTION_COLUMNS)
+        for k in range(len(pts["x"])):
+            w.writerow(
+                [
+                    f"{pts['x'][k]:.12e}",
+                    f"{pts['y'][k]:.12e}",
+                    f"{pts['p_n'][k]:.12e}",
+                    f"{pts['p_t'][k]:.12e}",
+                    f"{pts['gap_n'][k]:.12e}",
+                    f"{pts['slip'][k]:.12e}",
+                    STATE_NAMES[int(pts["state"][k])],
+                ]
+            )
+
+
+def write_columns(path, **columns):
+    """A CSV file of equally long columns {name: values}: a header line, then %.12e values."""
+    np.savetxt(
+        path,
+        np.column_stack(list(columns.values())),
+        delimiter=",",
+        fmt="%.12e",
+        header=",".join(columns),
+        comments="",
+    )
+
+
+def write_fields(folder, problem, name="solution"):
+    """Displacement (P1) and Cauchy stress (cellwise constant) in XDMF for ParaView."""
+    from dolfinx import fem, io
+
+    mesh = problem.mesh
+    V1 = fem.VectorFunctionSpace(mesh, ("Lagrange", 1))
+    u1 = fem.Function(V1, name="displacement")
+    u1.interpolate(problem.u)
+    sig = problem.stress(("DG", 0))  # the laws' own output stress
+    with io.XDMFFile(mesh.comm, str(Path(folder) / f"{name}.xdmf"), "w") as f:
+        f.write_mesh(mesh)
+        f.write_function(u1)
+        f.write_function(sig)
+
+
+def plot_tractions(path, pts, analytic=None, title="", xlabel="x (mm)", ylabel="traction (MPa)"):
+    """Computed p_n, p_t at the contact points against analytic curves {label: (x, y)}."""
+    lines = {"p_n computed": (pts["x"], pts["p_n"], ".")}
+    if np.any(pts["p_t"] != 0):
+        lines["p_t computed"] = (pts["x"], pts["p_t"], ".")
+    lines.update({label: (x, y, "-") for label, (x, y) in (analytic or {}).items()})
+    plot_lines(path, lines, title, xlabel, ylabel)
+
+
+def plot_lines(path, lines, title="", xlabel="x (mm)", ylabel="", vlines=()):
+    """Curves {label: (x, y, style)} (style "-": a line, ".": points) and dotted vertical lines
+    at the abscissae `vlines`, in one PNG (plot_worker.draw; in the worker of
+    `start_plot_worker`, or the demo's early one, if one was started and is unused)."""
+    global _worker
+    worker, _worker = _worker or plot_worker.take_early(), None
+    if worker is None or not worker.plot(path, lines, title, xlabel, ylabel, vlines):
+        plot_worker.draw(path, lines, title, xlabel, ylabel, vlines)
+
+
+_worker = None  # plot_worker.Worker of start_plot_worker, until plot_lines uses it
+
+
+def start_plot_worker():
+    """Start a worker process for the next plot_lines figure (plot_worker.py); a previous
+    unused one is ended."""
+    global _worker
+    stop_plot_worker()
+    _worker = plot_worker.take_early() or plot_worker.start()
+
+
+def stop_plot_worker():
+    """End the worker of start_plot_worker if plot_lines did not use it."""
+    global _worker
+    worker, _worker = _worker, None
+    if worker is not None:
+        worker.close()
+
+
+def finish(folder, metrics, problem, pts, plot=None):
+    """Everything beside metrics.json, then metrics.json (rank 0 writes the small files)."""
+    write_fields(folder, problem)
+    if problem.comm.rank == 0:
+        write_tractions(folder, pts)
+        if plot is not None:
+            plot(Path(folder) / "tractions.png")
+        write_metrics(folder, metrics)
+
+
+def window_average(x, p, width):
+    """Mean of p over the points within |x' - x| <= width / 2 of each point (vectorised).
+
+    Penalty tractions carry an element-scale ripple (amplitude ~ 1/eps0) that differs between
+    meshes; averaging over one cell width compares the resolved profiles of two
+    discretisations."""
+    x, p = np.asarray(x, float), np.asarray(p, float)
+    order = np.argsort(x, kind="stable")
+    xs, cs = x[order], np.concatenate([[0.0], np.cumsum(p[order])])
+    lo = np.searchsorted(xs, x - width / 2, side="left")
+    hi = np.searchsorted(xs, x + width / 2, side="right")
+    return (cs[hi] - cs[lo]) / (hi - lo)

@@ -1,0 +1,547 @@
+"""The implicit level-set MPM step loop (section 4.4 of the seed paper).
+
+Each body is a level set on a fixed uniform background grid plus material points; obstacles are
+rigid level sets (`obstacles.py`). One load step:
+
+1. the cut scene of the current level sets (`build_scene`, supplied by the application, e.g.
+   `meshes.mpm.grid_scene`): active cells, integration points; Gamma_c and the closest points
+   come from the current grid level sets (eqs 21-25), never from the initial shapes. The
+   DOLFINx mesh is rebuilt only when a body's active cells or their kinds (or the pairs)
+   change; forms and sparsity are made anew every step, because the cut weights and the
+   contact couplings move with the level sets;
+2. the material points' stress is projected to the integration points of the new cells by MLS
+   (eqs 38-45, `_cpp.MLSProjector`), per body, and enters the residual as the initial stress
+   int sigma_0 : grad v;
+3. the friction history is carried from the previous step's contact points to the new ones
+   (`transfer_friction`);
+4. Newton on the displacement increment du of the step (`ContactProblem`, penalty contact and
+   Coulomb friction, obstacles' motion and Dirichlet increments ramped with lam, cut-back);
+5. the material points move and update stress and volume (`material_points.update`);
+6. du is extended off each body along the normal (eq 20) and the level set advected by it
+   (eq 19, HJ-WENO5 + TVD-RK3), reinitialised when |grad phi| drifts; obstacles move.
+
+Nothing persistent changes before step 4 converges, and `snapshot`/`restore` copy every piece
+of state (points, level sets, obstacle poses, friction record, counters): a rejected step leaves
+the simulation exactly as it was.
+
+Small strain per step with the Jaumann update of the points' stress (material_points.py);
+laws must be linear (law_tangent). The background grid must be uniform (WENO5).
+"""
+
+from __future__ import annotations
+
+import time
+from contextlib import nullcontext
+from dataclasses import dataclass
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+
+from dolfinx_forms import _cpp
+from dolfinx_forms.mpm import material_points as mp
+from dolfinx_forms.common import allreduce_array
+from dolfinx_forms.fem.boundary import Load
+from dolfinx_forms.fem.cut import grid_cells
+from dolfinx_forms.fem.laws import as_law, law_key
+from dolfinx_forms.solvers.problem import ContactProblem, zone_ends
+
+
+@dataclass
+class MPMBody:
+    """A deformable body: name, cell tag, law (Law or (E, nu)) and initial shape (`_cpp.Shape`
+    sampled exactly at the grid nodes, or a `_cpp.LevelSet` on the background grid)."""
+
+    name: str
+    tag: int
+    law: object
+    shape: object
+
+
+def equilibrium_error(record):
+    """Largest |contact + support resultant| over the bodies of a step record, relative to the
+    largest normal contact force: every body's equilibrium in one number."""
+    worst = max(
+        np.hypot(*np.add(f[:2], record["support_forces"][n]))
+        for n, f in record["body_forces"].items()
+    )
+    return worst / max([q["normal_force"] for q in record["pairs"]] + [1e-300])
+
+
+def _stress_tensor(s):
+    return ufl.as_matrix([[s[0], s[2]], [s[2], s[1]]])
+
+
+class ImplicitMPM:
+    """Bodies and rigid obstacles over many load steps (module docstring).
+
+    grid: (xlines, ylines) of the uniform background grid; build_scene(levelsets) -> Scene: the
+    cut scene of {tag: _cpp.LevelSet} on that grid (bodies in the order of `bodies`); obstacles:
+    `RigidObstacle`s with their motion per step; dirichlet: `Dirichlet` conditions whose values
+    are the increments of one step (at lam = 1); reinit_drift: reinitialise a level set when
+    max | |grad phi| - 1 | within 3 h of its zero contour exceeds it. Other keywords go to
+    `ContactProblem` (mu, eps0, band, newton, petsc_options, ghost_penalty, ...)."""
+
+    def __init__(
+        self,
+        comm,
+        grid,
+        bodies,
+        build_scene,
+        *,
+        obstacles=(),
+        dirichlet=(),
+        reinit_drift=0.2,
+        timer=None,
+        log=print,
+        **problem_kw,
+    ):
+        self.comm = comm
+        self.xlines, self.ylines = (np.asarray(v, float) for v in grid)
+        self.grid = _cpp.StructuredGrid(self.xlines, self.ylines)
+        self.h = float(self.grid.max_spacing)
+        if not np.isclose(self.grid.min_spacing, self.h, rtol=1e-9):
+            raise ValueError("ImplicitMPM: the background grid must be uniform (WENO5 advection)")
+        self.bodies = list(bodies)
+        self.laws = {b.tag: as_law(b.law) for b in self.bodies}
+        tangents = {}  # one per distinct law (13 bodies of one material: 0.4 s -> 0.03 s)
+        for law in self.laws.values():
+            if law_key(law) not in tangents:
+                tangents[law_key(law)] = mp.law_tangent(law)
+        self.C = {tag: tangents[law_key(law)] for tag, law in self.laws.items()}
+        self.levelsets = {}
+        for b in self.bodies:
+            if isinstance(b.shape, _cpp.LevelSet):
+                self.levelsets[b.tag] = _cpp.LevelSet(
+                    self.grid, b.shape.evaluate(self.grid.nodes())[0]
+                )
+            else:
+                self.levelsets[b.tag] = _cpp.levelset_from_shape(self.grid, b.shape)
+        self.build_scene = build_scene
+        self.obstacles = list(obstacles)
+        self.dirichlet = list(dirichlet)
+        self.reinit_drift = float(reinit_drift)
+        self.timer = timer
+        self.log = log if comm.rank == 0 else (lambda *a, **k: None)
+        if problem_kw.get("enforcement", "penalty") != "penalty":
+            raise ValueError(
+                "enforcement: the multi-step MPM supports 'penalty' only (its friction transfer "
+                "carries point-wise slip from step to step, and its contacts span about one "
+                "grid cell, too few for the augmented Lagrangian's P1 multipliers)"
+            )
+        self.problem_kw = problem_kw
+        self.points = None  # {tag: MaterialPoints}, seeded on the first scene
+        self.friction = {}  # pair key -> (points (n, 2), elastic tangential gap (n,))
+        self.step_count = 0
+        self.problem = None
+        self.scene = None
+        self._key = None  # _scene_key of self.scene
+
+    # ------------------------------------------------------------------ state
+    def phase(self, name):
+        return nullcontext() if self.timer is None else self.timer.phase(name)
+
+    def snapshot(self):
+        """Every piece of state a step changes (deep copies)."""
+        return dict(
+            points=None if self.points is None else {t: p.copy() for t, p in self.points.items()},
+            levelsets={
+                t: _cpp.LevelSet(self.grid, l.values.ravel()) for t, l in self.levelsets.items()
+            },
+            obstacles=[ob.state() for ob in self.obstacles],
+            friction={k: (x.copy(), e.copy()) for k, (x, e) in self.friction.items()},
+            step_count=self.step_count,
+        )
+
+    def restore(self, snap):
+        self.points = (
+            None if snap["points"] is None else {t: p.copy() for t, p in snap["points"].items()}
+        )
+        self.levelsets = {
+            t: _cpp.LevelSet(self.grid, l.values.ravel()) for t, l in snap["levelsets"].items()
+        }
+        for ob, s in zip(self.obstacles, snap["obstacles"]):
+            ob.set_state(s)
+        self.friction = {k: (x.copy(), e.copy()) for k, (x, e) in snap["friction"].items()}
+        self.step_count = snap["step_count"]
+
+    # ------------------------------------------------------------------ one step
+    def step(self):
+        """One load step (module docstring). Returns the step record (dict). On failure
+        (ContactSolverError, RuntimeError) the state is restored and the error re-raised."""
+        snap = self.snapshot()
+        try:
+            return self._step()
+        except Exception:
+            self.restore(snap)
+            raise
+
+    def _step(self):
+        t0 = time.perf_counter()
+        with self.phase("mesh"):
+            pairs = self.candidate_pairs()
+            ranks, contact_boxes = self.contact_ranks(pairs)
+            key, boxes = self._scene_key(pairs)
+            if contact_boxes is not None:
+                key += [contact_boxes["boxes"].tobytes(), contact_boxes["owners"].tobytes()]
+            rebuilt = self.scene is None or key != self._key
+            if rebuilt:
+                scene = self.build_scene(dict(self.levelsets), pairs, contact_boxes)
+            else:  # same active cells, kinds and pairs: the mesh and its tags stay
+                scene = self.scene
+                for body, b, box in zip(scene.bodies, self.bodies, boxes):
+                    body.shape = scene.cut.levelsets[b.tag] = self.levelsets[b.tag]
+                    body.bbox = box
+        sigma0 = None
+        if self.points is not None:
+            with self.phase("mls"):
+                sigma0, mls_info = self._project(scene)
+        else:
+            mls_info = {"widened": 0}
+        loads = []
+        if sigma0 is not None:
+            S = _stress_tensor(sigma0)
+            loads.append(
+                Load(
+                    lambda v, measure: -ufl.inner(S, ufl.grad(v)) * measure(None, degree=mp.DEGREE),
+                    scale=lambda lam: 1.0,
+                )
+            )
+        kw = dict(self.problem_kw)
+        kw.setdefault("pair_grid_origin", (self.xlines[0], self.ylines[0]))
+        if ranks is not None:
+            kw["contact_rank"] = ranks
+        problem = ContactProblem(
+            scene,
+            self.laws,
+            dirichlet=self.dirichlet,
+            loads=loads,
+            obstacles=self.obstacles,
+            timer=self.timer,
+            log=self.log,
+            **kw,
+        )
+        if self.points is None:
+            self.points = {b.tag: mp.seed(scene, problem.integration, b.tag) for b in self.bodies}
+        keys = problem.contact.names(scene)
+        with self.phase("contact"):
+            self._transfer_friction(problem, keys)
+        problem.solve(1, 1.0, label=f"MPM step {self.step_count + 1}")
+        # ---- converged: from here on the state changes
+        record = self._contact_record(problem, scene, keys)
+        record["support_forces"] = self._support_forces(problem, scene)
+        with self.phase("points"):
+            outside = 0
+            moved = []
+            for b in self.bodies:
+                pts = self.points[b.tag]
+                du, grad, n_out = mp.displacement_at(problem, b.tag, pts.x, self.h)
+                mp.update(pts, du, grad, self.C[b.tag])
+                outside += n_out
+                moved.append(du)
+            if self.step_count == 0:
+                self.first_step_du = moved
+        with self.phase("evolution"):
+            evo = self._evolve(problem, scene)
+        for ob in self.obstacles:
+            ob.advance(1.0)
+        self.step_count += 1
+        self.problem, self.scene, self._key = problem, scene, key
+        imap = problem.V.dofmap.index_map
+        record.update(
+            step=self.step_count,
+            newton_iterations=int(sum(s.iterations for s in problem.steps)),
+            cutbacks=int(sum(s.cutback for s in problem.steps)),
+            num_dofs=int(imap.size_global * problem.bs),
+            num_cells=int(scene.mesh.topology.index_map(2).size_global),
+            points_outside_cells=outside,
+            mesh_rebuilt=bool(rebuilt),
+            mls_widened=mls_info["widened"],
+            mass={b.name: float(self.points[b.tag].vol0.sum()) for b in self.bodies},
+            volume_points={b.name: float(self.points[b.tag].vol.sum()) for b in self.bodies},
+            wall_s=time.perf_counter() - t0,
+            **evo,
+        )
+        return record
+
+    # ------------------------------------------------------------------ parts
+    def body_boxes(self):
+        """(n, 2, 2) bounding box of each body's material: the grid nodes with phi <= 0, grown by
+        one spacing (the zero contour lies within it)."""
+        X, Y = np.meshgrid(self.xlines, self.ylines)
+        out = []
+        for b in self.bodies:
+            inside = self.levelsets[b.tag].values <= 0
+            if not inside.any():
+                raise RuntimeError(f"body {b.name!r}: its level set has no node inside")
+            lo = np.array([X[inside].min(), Y[inside].min()]) - self.h
+            hi = np.array([X[inside].max(), Y[inside].max()]) + self.h
+            out.append([lo, hi])
+        return np.array(out)
+
+    def _scene_key(self, pairs):
+        """What decides the cut mesh: each body's active cells and their kinds (interior/cut,
+        `cut.grid_cells`), and the pairs; with the bodies' material boxes."""
+        key, boxes = [tuple(pairs)], []
+        for b in self.bodies:
+            g = grid_cells(self.xlines, self.ylines, self.levelsets[b.tag].values.ravel())
+            key += [g["active"].tobytes(), g["kinds"].tobytes()]
+            boxes.append(g["bbox"])
+        return key, boxes
+
+    def contact_ranks(self, pairs):
+        """In parallel: the box of each pair's contact region (grid nodes within the band of
+        both bodies, grown by the band and 2 h: Gamma_c, its closest points and their cells lie
+        inside) and the rank that computes it. Pairs go to ranks in contiguous groups along the
+        domain's longest axis, each pair on its own rank whatever its neighbours: the
+        partitioner gives each box's cells to its rank, as owned cells or, where another box
+        already claimed them, as ghost cells (`dolfinx_forms.mesh.scene.contact_partitioner`).
+        Returns ({pair_key: rank}, {"boxes", "owners"}) or (None, None) on one rank."""
+        size = self.comm.size
+        if size == 1:
+            return None, None
+        band = self.problem_kw.get("band") or 2 * self.h
+        X, Y = np.meshgrid(self.xlines, self.ylines)
+        P = np.stack([X.ravel(), Y.ravel()], axis=1)
+        near = {b.tag: self.levelsets[b.tag].values.ravel() < band for b in self.bodies}
+        keys, boxes = [], []
+
+        def add(key, mask):
+            if mask.any():
+                q = P[mask]
+                grow = 2 * self.h  # P_i, P_j lie within band / 2 of Gamma_c: their cells in here
+                keys.append(key)
+                boxes.append([q.min(axis=0) - grow, q.max(axis=0) + grow])
+
+        for i, j in pairs:
+            add((i, j), near[self.bodies[i].tag] & near[self.bodies[j].tag])
+        for ob in self.obstacles:
+            for i, b in enumerate(self.bodies):
+                if ob.bodies is None or b.tag in np.atleast_1d(ob.bodies):
+                    m = near[b.tag].copy()
+                    m[m] = ob.values(P[m]) < band
+                    add((i, ob.name), m)
+        if not keys:
+            return None, None
+        boxes = np.array(boxes)
+        axis = int(np.argmax(np.ptp(P, axis=0)))
+        order = np.argsort(0.5 * (boxes[:, 0, axis] + boxes[:, 1, axis]), kind="stable")
+        owners = np.empty(len(keys), np.int32)
+        owners[order] = (np.arange(len(keys)) * size) // len(keys)
+        ranks = {k: int(r) for k, r in zip(keys, owners)}
+        return ranks, {"boxes": boxes, "owners": owners}
+
+    def candidate_pairs(self):
+        """Body pairs whose boxes, inflated by the contact band (and the level-set grid of the
+        pair search), overlap: the broad phase (`_cpp.candidate_pairs`, sort and sweep), so the
+        narrow phase (Gamma_c, eqs 21-24) runs on touching pairs only."""
+        if len(self.bodies) < 2:
+            return []
+        band = self.problem_kw.get("band") or 2 * self.h
+        pairs = _cpp.candidate_pairs(self.body_boxes().reshape(len(self.bodies), 4), 0.5 * band)
+        return [tuple(int(v) for v in p) for p in np.asarray(pairs).reshape(-1, 2)]
+
+    def _project(self, scene):
+        """MLS projection of each body's point stress to the Gauss points (degree mp.DEGREE) of
+        its cells: a `Quadrature` vector function [s_xx, s_yy, s_xy]."""
+        mesh = scene.mesh
+        Qe = ufl.VectorElement(
+            "Quadrature", mesh.ufl_cell(), mp.DEGREE, dim=3, quad_scheme="default"
+        )
+        sigma0 = fem.Function(fem.FunctionSpace(mesh, Qe), name="sigma0")
+        qdofs = sigma0.function_space.dofmap.list.array.reshape(len(scene.cell_tags.values), -1)
+        arr = sigma0.x.array.reshape(-1, 3)
+        widened = 0
+        for b in self.bodies:
+            cells = scene.cell_tags.indices[scene.cell_tags.values == b.tag]
+            if len(cells) == 0:
+                continue
+            targets = mp.quadrature_points(scene, cells).reshape(-1, 2)
+            pts = self.points[b.tag]
+            r = _cpp.MLSProjector(pts.x, self.h).project(pts.stress, np.ascontiguousarray(targets))
+            arr[qdofs[cells].ravel()] = r["values"]
+            widened += int(np.sum(r["widening"] > 1))
+        widened = self.comm.allreduce(widened, op=MPI.SUM)
+        if widened:
+            self.log(f"MLS: {widened} integration points needed a wider support (reported)")
+        return sigma0, {"widened": widened}
+
+    def _support_forces(self, problem, scene):
+        """{body: [fx, fy]} exerted on each body by its Dirichlet conditions: the residual
+        (internal - external + contact forces) summed over the body's prescribed dofs."""
+        out = {}
+        if not problem.dirichlet:
+            return {b.name: [0.0, 0.0] for b in self.bodies}
+        problem.residual(1.0, zero_bc=False)
+        R = problem.R.array.reshape(-1, 2)
+        owned = problem.n_owned
+        bc = np.zeros(owned, bool)
+        bc[problem.bc_owned] = True
+        cell_dofs = problem.V.dofmap.list.array.reshape(-1, 4)
+        for b in self.bodies:
+            nodes = np.unique(cell_dofs[scene.cell_tags.find(b.tag)])
+            nodes = nodes[2 * nodes + 1 < owned]
+            f = np.zeros(2)
+            for c in range(2):
+                sel = bc[2 * nodes + c]
+                f[c] = R[nodes[sel], c].sum()
+            out[b.name] = allreduce_array(self.comm, f, MPI.SUM).tolist()
+        return out
+
+    def _transfer_friction(self, problem, keys):
+        """Each new contact point starts from the elastic tangential gap e_t = g_t - g_t^p of
+        the nearest contact point of the same pair in the previous step (moved with the
+        bodies) if one lies within h, else from zero tangential traction: its committed slip is
+        set to -e_t, so the trial traction at du = 0 is the old one (eq 11)."""
+        cs = problem.contact
+        if cs.mu == 0:
+            return
+        from scipy.spatial import cKDTree
+
+        for k, g in enumerate(cs.pairs):
+            old = self.friction.get(keys[k])
+            gtp = np.zeros(len(g.weights))
+            if old is not None and len(old[0]):
+                d, idx = cKDTree(old[0]).query(g.points)
+                near = d <= self.h
+                gtp[near] = -old[1][idx[near]]
+            cs.set_committed_slip(k, gtp)
+
+    def _contact_record(self, problem, scene, keys):
+        """Per pair: resultants, active zone, stick fraction; per obstacle: force and moment;
+        the friction record for the next step (points moved by the mean step displacement)."""
+        cs = problem.contact
+        pairs = []
+        self.friction = {}
+        for k, g in enumerate(cs.pairs):
+            s = cs.committed[k]
+            active = s["state"] != 0
+            w = g.weights
+            pn, pt = -s["tau_n"], s["tau_t"]
+            order = np.argsort(g.points[:, 0])
+            xl, xr = zone_ends(g.points[order, 0], active[order], s["g_n"][order])
+            wa = w[active]
+            f = -(s["tau_n"][:, None] * g.normals + s["tau_t"][:, None] * g.tangents) * w[:, None]
+            pairs.append(
+                dict(
+                    fx=float(f[:, 0].sum()),  # resultant on body j (the obstacle) from body i
+                    fy=float(f[:, 1].sum()),
+                    body_i=keys[k][0],
+                    body_j=keys[k][1],
+                    x=float(np.average(g.points[active, 0], weights=wa)) if active.any() else 0.0,
+                    y=float(np.average(g.points[active, 1], weights=wa)) if active.any() else 0.0,
+                    normal_force=float(np.sum(w * pn)),
+                    tangential_force=float(np.sum(w * pt)),
+                    active_length=float(np.sum(wa)),
+                    stick_fraction=float(np.sum(w[s["state"] == 1]) / np.sum(wa))
+                    if active.any()
+                    else 0.0,
+                    half_width=0.0 if xl is None else 0.5 * (xr - xl),
+                    num_points=int(len(w)),
+                )
+            )
+            if cs.mu > 0:
+                self.friction[keys[k]] = (g.points.copy(), cs.elastic_slip(k))
+        # each pair lives on one rank: share the records, in the order of one rank
+        gathered = self.comm.allgather(list(zip(cs.index, pairs)))
+        pairs = [p for _, p in sorted((q for lst in gathered for q in lst), key=lambda q: q[0])]
+        self.friction = {k: v for d in self.comm.allgather(self.friction) for k, v in d.items()}
+        # contact resultants on each body: +sum w (tau_n n + tau_t t) on side i, the opposite on
+        # side j; moment about the body's material-point centroid
+        forces = {b.name: np.zeros(3) for b in self.bodies}
+        for k, g in enumerate(cs.pairs):
+            s = cs.committed[k]
+            f = (s["tau_n"][:, None] * g.normals + s["tau_t"][:, None] * g.tangents) * g.weights[
+                :, None
+            ]
+            for sign, name, p in ((1.0, keys[k][0], g.p_i), (-1.0, keys[k][1], g.p_j)):
+                if name in forces:
+                    b = next(b for b in self.bodies if b.name == name)
+                    c = np.average(self.points[b.tag].x, axis=0, weights=self.points[b.tag].vol)
+                    r = p - c
+                    forces[name] += sign * np.array(
+                        [
+                            f[:, 0].sum(),
+                            f[:, 1].sum(),
+                            np.sum(r[:, 0] * f[:, 1] - r[:, 1] * f[:, 0]),
+                        ]
+                    )
+        body_forces = {
+            n: allreduce_array(self.comm, v, MPI.SUM).tolist() for n, v in forces.items()
+        }
+        res = cs.obstacle_resultants()
+        obstacles = {}
+        for ob in self.obstacles:
+            F, M = res[ob.name]
+            F = allreduce_array(self.comm, np.asarray(F, float), MPI.SUM)
+            obstacles[ob.name] = dict(
+                fx=float(F[0]), fy=float(F[1]), moment=self.comm.allreduce(M, op=MPI.SUM)
+            )
+        return dict(pairs=pairs, obstacles=obstacles, body_forces=body_forces)
+
+    def _evolve(self, problem, scene):
+        """Extend du off each body (eq 20), advect its level set (eq 19), reinitialise on drift."""
+        V = problem.V
+        nx, ny = len(self.xlines), len(self.ylines)
+        xdof = V.tabulate_dof_coordinates()[:, :2]
+        i = np.rint((xdof[:, 0] - self.xlines[0]) / self.h).astype(np.int64)
+        j = np.rint((xdof[:, 1] - self.ylines[0]) / self.h).astype(np.int64)
+        node = i + nx * j
+        owned = V.dofmap.index_map.size_local
+        cell_dofs = V.dofmap.list.array.reshape(-1, 4)
+        u = problem.u.x.array.reshape(-1, 2)
+        out = dict(area_levelset={}, advection_substeps={}, reinitialized={}, gradient_drift={})
+        nn = self.grid.num_nodes
+        self.grid_increments = {}
+        for b in self.bodies:
+            dofs = np.unique(cell_dofs[scene.cell_tags.find(b.tag)])
+            dofs = dofs[dofs < owned]
+            vel = np.zeros((nn, 2))
+            has = np.zeros(nn, np.int8)
+            vel[node[dofs]] = u[dofs]
+            has[node[dofs]] = 1
+            vel = allreduce_array(self.comm, vel, MPI.SUM)
+            has = allreduce_array(self.comm, has, MPI.MAX)
+            phi = self.levelsets[b.tag]
+            # known: every node of the body's active cells. The FE increment on the outside
+            # nodes of cut cells is the unfitted method's own (smooth, ghost-penalised)
+            # extension, second order at the interface; the constant normal extension of
+            # eq 20 fills the rest of the grid. (Extending from the inside nodes only would move
+            # the interface by du at a node up to h inside: first order, and the level set
+            # would lag the material by ~ h grad(du) per step.)
+            known = (has > 0).reshape(ny, nx)
+            # a window of the grid around the body (its active nodes grown by 6 cells and the
+            # step's largest motion): a grain costs its own size, not the grid's. Beyond it the
+            # level set keeps its (positive, far-field) values.
+            jj, ii = np.nonzero(known)
+            m = 6 + int(np.ceil(np.abs(vel).max() / self.h))
+            i0, i1 = max(ii.min() - m, 0), min(ii.max() + m, nx - 1)
+            j0, j1 = max(jj.min() - m, 0), min(jj.max() + m, ny - 1)
+            win = (slice(j0, j1 + 1), slice(i0, i1 + 1))
+            sub = _cpp.StructuredGrid(self.xlines[i0 : i1 + 1], self.ylines[j0 : j1 + 1])
+            values = phi.values  # (ny, nx) copy
+            v = vel.reshape(ny, nx, 2)[win].reshape(-1, 2)
+            v = _cpp.extend_normal(
+                sub,
+                values[win].ravel(),
+                known[win].ravel().astype(np.int8),
+                np.ascontiguousarray(v),
+            )
+            full = np.zeros((ny, nx, 2))
+            full[win] = v.reshape(j1 - j0 + 1, i1 - i0 + 1, 2)
+            self.grid_increments[b.name] = full.reshape(-1, 2)
+            r = _cpp.advect_levelset(_cpp.LevelSet(sub, values[win].ravel()), v, 1.0, 0.5)
+            new = r["levelset"]
+            drift = float(_cpp.levelset_gradient_drift(new, 3 * self.h))
+            redo = drift > self.reinit_drift
+            if redo:
+                new = _cpp.reinitialize(new)
+            area = float(_cpp.levelset_area(new))
+            values[win] = new.values
+            self.levelsets[b.tag] = _cpp.LevelSet(self.grid, values.ravel())
+            out["area_levelset"][b.name] = area
+            out["advection_substeps"][b.name] = int(r["substeps"])
+            out["reinitialized"][b.name] = bool(redo)
+            out["gradient_drift"][b.name] = drift
+        return out

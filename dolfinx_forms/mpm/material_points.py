@@ -1,0 +1,205 @@
+"""Material points of the implicit MPM (sections 3.1 and 4.4 of the seed paper).
+
+A body's material points carry position x, reference volume vol0 (mass / density: constant, so
+mass is conserved exactly), current volume vol and Cauchy stress [s_xx, s_yy, s_xy]. They are
+seeded at integration points with positive weights: the 3x3 Gauss points of interior cells and
+the points of the sub-triangle rule of the inside polygon of cut cells (`_cpp.cut_quadrature`,
+the polygon the cut integration uses), so that the volumes sum to the body's discrete area.
+
+After a converged step (displacement increment du on the step's grid) each point moves with the
+FE interpolant in the cell that holds it and updates its stress by the objective
+small-strain increment (stated choice: Jaumann rate, first order in the step)
+
+    sigma <- sigma + C : d_eps + dW sigma - sigma dW,   d_eps = sym grad du, dW = skew grad du,
+
+with C the body's linear law (`law_tangent`), and vol <- vol det(I + grad du). A rigid rotation
+therefore rotates the stress instead of creating it, and a rigid translation leaves everything
+but x unchanged (exactly: grad du = 0 there up to round-off).
+
+Parallel: the points of every body are replicated on all ranks (seeded from the owned cells
+and gathered); the increment at a point is taken from the rank that owns its grid cell.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import basix
+import numpy as np
+import ufl
+from dolfinx import fem, mesh as dmesh
+from mpi4py import MPI
+
+from dolfinx_forms import _cpp
+from dolfinx_forms.common import allreduce_array
+from dolfinx_forms.fem.cut import CUT, shape_values
+from dolfinx_forms.geometry.pairs import GridLocator
+
+DEGREE = 4  # 3x3 Gauss points per cell: the cut cells' rule (cut.CutIntegration)
+
+
+@dataclass
+class MaterialPoints:
+    """The material points of one body (see the module docstring)."""
+
+    tag: int
+    x: np.ndarray  # (n, 2)
+    vol0: np.ndarray  # (n,)
+    vol: np.ndarray  # (n,)
+    stress: np.ndarray  # (n, 3) Cauchy [xx, yy, xy]
+
+    def __len__(self):
+        return len(self.vol0)
+
+    def copy(self):
+        return MaterialPoints(
+            self.tag, self.x.copy(), self.vol0.copy(), self.vol.copy(), self.stress.copy()
+        )
+
+
+def law_tangent(law):
+    """The constant Voigt matrix C (3, 3) of a linear small-strain law, [s_xx, s_yy, s_xy] =
+    C [e_xx, e_yy, 2 e_xy], evaluated from the law's own UFL stress (one expression for the
+    stress everywhere) on a one-cell mesh. ValueError for a nonlinear law."""
+    if not law.linear:
+        raise ValueError(
+            f"{type(law).__name__}: the MPM stress update needs a linear small-strain law "
+            "(C : d_eps); nonlinear laws are not supported on the multi-step path"
+        )
+    m = dmesh.create_unit_square(MPI.COMM_SELF, 1, 1, dmesh.CellType.quadrilateral)
+    x = ufl.SpatialCoordinate(m)
+    C = np.zeros((3, 3))
+    point = np.array([[0.5, 0.5]])
+    for k, G in enumerate(([[1, 0], [0, 0]], [[0, 0], [0, 1]], [[0, 0.5], [0.5, 0]])):
+        u = ufl.as_matrix(G) * x
+        s = fem.Expression(law.stress(u), point).eval(np.array([0], np.int32)).reshape(2, 2)
+        C[:, k] = s[0, 0], s[1, 1], s[0, 1]
+    return C
+
+
+def _cell_frames(scene, cells):
+    """Origin (n, 2) and edge lengths (n, 2) of axis-aligned grid cells (DOLFINx vertex order
+    (0,0), (1,0), (0,1), (1,1))."""
+    g = scene.mesh.geometry.dofmap.array.reshape(-1, 4)[cells]
+    x = scene.mesh.geometry.x[g][:, :, :2]
+    return x[:, 0], np.stack([x[:, 1, 0] - x[:, 0, 0], x[:, 2, 1] - x[:, 0, 1]], axis=1)
+
+
+def quadrature_points(scene, cells, degree=DEGREE):
+    """Physical coordinates (len(cells), nq, 2) of the reference Gauss points of `degree` in
+    each cell: the points of a `Quadrature` element of that degree."""
+    X, _ = basix.make_quadrature(basix.CellType.quadrilateral, degree)
+    o, e = _cell_frames(scene, cells)
+    return o[:, None, :] + X[None, :, :] * e[:, None, :]
+
+
+def _canonical(scene, cells):
+    """Corner (n, 2), extents (n, 2) and the permutation (n, 4) that puts each cell's vertices
+    in tensor order (x-fastest) by their coordinates: the same points for a cell whatever the
+    vertex order of its partition (1 and 2 ranks seed identical points)."""
+    g = scene.mesh.geometry.dofmap.array.reshape(-1, 4)[cells]
+    x = scene.mesh.geometry.x[g][:, :, :2]
+    lo, hi = x.min(axis=1), x.max(axis=1)
+    key = (x[:, :, 0] > 0.5 * (lo + hi)[:, None, 0]) + 2 * (
+        x[:, :, 1] > 0.5 * (lo + hi)[:, None, 1]
+    )
+    return lo, hi - lo, np.argsort(key, axis=1)
+
+
+def seed(scene, integration, tag):
+    """Material points of body `tag` at the positive integration points of its active cells
+    (owned cells of every rank, gathered), zero stress."""
+    comm = scene.mesh.comm
+    owned = scene.mesh.topology.index_map(2).size_local
+    cells = scene.cell_tags.indices[scene.cell_tags.values == tag]
+    cells = cells[cells < owned]
+    kind = integration.kind[cells]
+    X, w = basix.make_quadrature(basix.CellType.quadrilateral, DEGREE)
+    inner = cells[kind != CUT]
+    o, e, _ = _canonical(scene, inner)
+    xs = [(o[:, None, :] + X[None] * e[:, None, :]).reshape(-1, 2)]
+    vs = [(w[None, :] * np.prod(e, axis=1)[:, None]).ravel()]
+    cut = cells[kind == CUT]
+    if len(cut):
+        o, e, perm = _canonical(scene, cut)
+        # phi at the exact vertex coordinates (not the dof coordinates, which carry round-off
+        # that differs with the partition and flips the sign of phi at a vertex on the contour)
+        g = scene.mesh.geometry.dofmap.array.reshape(-1, 4)[cut]
+        xv = np.take_along_axis(g, perm, axis=1).ravel()
+        phi = shape_values(scene.cut.levelsets[tag], scene.mesh.geometry.x[xv, :2]).reshape(-1, 4)
+        q = _cpp.cut_quadrature(np.ascontiguousarray(phi), 2)
+        owner = np.repeat(np.arange(len(cut)), np.diff(q["offsets"]))
+        # sub-triangles of zero area (a contour through a vertex) carry no mass: no point
+        keep = q["weights"] > 1e-12
+        xs.append((o[owner] + q["points"] * e[owner])[keep])
+        vs.append((q["weights"] * np.prod(e, axis=1)[owner])[keep])
+    x = np.concatenate(comm.allgather(np.concatenate(xs)))
+    vol = np.concatenate(comm.allgather(np.concatenate(vs)))
+    return MaterialPoints(int(tag), x, vol.copy(), vol.copy(), np.zeros((len(vol), 3)))
+
+
+def displacement_at(problem, tag, points, max_distance):
+    """Displacement (n, 2) and its gradient (n, 2, 2) of problem.u at points of body `tag`
+    (replicated on all ranks), from the rank owning each point's cell. A point outside the
+    body's active cells (its level set moved past it by O(h^2)) takes the nearest active cell
+    within max_distance (extrapolated). Returns (u, grad u, number of such points); RuntimeError
+    if a point is further than max_distance from every cell."""
+    scene, V = problem.scene, problem.V
+    comm = scene.mesh.comm
+    # each rank's best owned cell, then the nearest over the ranks (ties: the lowest rank):
+    # the same cell as on one rank whatever the partition
+    loc = GridLocator(scene.mesh, scene.cell_tags, tag, scene.cut, 1, owned_only=True)
+    cells, X, outside = loc.locate(points, max_distance)
+    best = allreduce_array(comm, outside, MPI.MIN)
+    mine = (cells >= 0) & (outside == best)
+    chosen = allreduce_array(comm, np.where(mine, comm.rank, comm.size).astype(np.int32), MPI.MIN)
+    lost = np.flatnonzero(chosen == comm.size)
+    if len(lost):
+        raise RuntimeError(
+            f"material point {points[lost[0]]} of body {tag} is not within {max_distance:g} of "
+            "an active cell of its body (the level set and the points have parted)"
+        )
+    take = np.flatnonzero(chosen == comm.rank)
+    val = np.zeros((len(points), 6))
+    if len(take):
+        tab = q1_basis(X[take])  # (3, n, 4): value, d/dX, d/dY
+        dofs = V.dofmap.list.array.reshape(-1, 4)[cells[take]]
+        uloc = problem.u.x.array.reshape(-1, 2)[dofs]  # (n, 4, 2)
+        # the cells' edge lengths, gathered once per cell (many points share one)
+        used, at = np.unique(cells[take], return_inverse=True)
+        e = _cell_frames(scene, used)[1][at]
+        val[take, :2] = np.einsum("na,nac->nc", tab[0], uloc)
+        # d/dx_d = d/dX_d / h_d on axis-aligned cells; columns 2..: du_x/dx, du_x/dy, du_y/dx,
+        # du_y/dy
+        gx = np.einsum("na,nac->nc", tab[1], uloc) / e[:, :1]
+        gy = np.einsum("na,nac->nc", tab[2], uloc) / e[:, 1:]
+        val[take, 2:] = np.stack([gx[:, 0], gy[:, 0], gx[:, 1], gy[:, 1]], axis=1)
+    val = allreduce_array(comm, val, MPI.SUM)
+    grad = val[:, 2:].reshape(-1, 2, 2)  # grad[:, c, d] = du_c / dx_d
+    n_out = comm.allreduce(int(np.sum(outside[take] > 0)), op=MPI.SUM)
+    return val[:, :2], grad, n_out
+
+
+def q1_basis(X):
+    """The Q1 basis on the reference square in DOLFINx's (basix's) order (0,0), (1,0), (0,1),
+    (1,1) at reference points X (n, 2) (extrapolated outside): values, d/dX and d/dY, (3, n, 4).
+    Closed form: ~1 ms for the Brazilian disc's 70k points, basix's tabulate 5-60 ms."""
+    x, y = X[:, 0], X[:, 1]
+    t = np.empty((3, len(X), 4))
+    t[0, :, 0], t[0, :, 1] = (1 - x) * (1 - y), x * (1 - y)
+    t[0, :, 2], t[0, :, 3] = (1 - x) * y, x * y
+    t[1, :, 0], t[1, :, 1], t[1, :, 2], t[1, :, 3] = y - 1, 1 - y, -y, y
+    t[2, :, 0], t[2, :, 1], t[2, :, 2], t[2, :, 3] = x - 1, -x, 1 - x, x
+    return t
+
+
+def update(points, du, grad, C):
+    """Move the points by du and update stress and volume (module docstring); in place."""
+    e = np.stack([grad[:, 0, 0], grad[:, 1, 1], grad[:, 0, 1] + grad[:, 1, 0]], axis=1)
+    s = points.stress
+    w = 0.5 * (grad[:, 0, 1] - grad[:, 1, 0])  # dW = [[0, w], [-w, 0]]
+    rot = np.stack([2 * w * s[:, 2], -2 * w * s[:, 2], w * (s[:, 1] - s[:, 0])], axis=1)
+    points.stress = s + e @ C.T + rot
+    points.x = points.x + du
+    F = np.eye(2)[None] + grad
+    points.vol = points.vol * (F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0])
