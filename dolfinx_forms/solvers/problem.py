@@ -26,6 +26,7 @@ from dolfinx_forms.fem.bulk import BulkForms
 from dolfinx_forms.geometry.pairs import DEFAULT_MULTIPLIER_MASS, MULTIPLIER_MASSES, TRACTIONS
 from dolfinx_forms.solvers import blas, linear
 from dolfinx_forms.contact.contact_set import ContactSet
+from dolfinx_forms.contact.penalty import contact_modulus, penalty_parameter
 from dolfinx_forms.fem.laws import as_law
 from dolfinx_forms.solvers.newton import NewtonOptions, load_steps
 
@@ -62,27 +63,14 @@ CONSISTENT_EPS0_T = 1.0
 BLAS_ONE_THREAD_DOFS = 50_000
 
 
-def contact_modulus(scene, laws, obstacles=()):
-    """The modulus the augmented Lagrangian's point-wise regularisation is scaled by: over the
-    pairs, the smallest harmonic mean 2 / (1/E_i + 1/E_j) of the two bodies' moduli (a rigid
-    obstacle: 2 E of its body), i.e. the most compliant contact. Equal moduli give E (what
-    POINTWISE_EPS0 was chosen with); the mean of all moduli instead made a soft disc between
-    stiff blocks (E 200 and 1e5: 66733 against 399) 167 times too stiff there, a checkerboard."""
-    E = {b.tag: laws[int(b.tag)].modulus for b in scene.bodies}
-    tags = [b.tag for b in scene.bodies]
-    pairs = [2.0 * E[tags[i]] * E[tags[j]] / (E[tags[i]] + E[tags[j]]) for i, j in scene.pairs]
-    for ob in obstacles:
-        held = [t for t in tags if ob.bodies is None or t in np.atleast_1d(ob.bodies)]
-        pairs += [2.0 * E[t] for t in held]
-    return min(pairs) if pairs else float(np.mean(list(E.values())))
-
-
 class ContactProblem:
     """Bodies of a `dolfinx_forms.mesh.scene.Scene` in frictional contact (penalty, eqs 8-12, 48).
 
     materials: {body tag: Law or (E, nu)} (`laws.py`; (E, nu) is `LinearElastic`); mu:
     friction coefficient (0: frictionless, no friction work); eps0: penalty factor of eq 51,
-    eps_n = eps_t = eps0 h / E_mean with E_mean the mean of the laws' moduli; band: largest
+    eps_n = eps_t = eps0 h / E_c, E_c the most compliant contact's modulus
+    (`contact.penalty.contact_modulus`: E on equal moduli, 2 E against a rigid obstacle); band:
+    largest
     initial gap that Gamma_c covers (a length); degree: Lagrange degree (1 or 2; 1 on a cut
     scene); loads: `BodyForce`/`Load`s; quadrature_degree: see `BulkForms`. A scene with `cut`
     data (meshes.cut) integrates over the inside part of cut cells (`cut.CutIntegration`,
@@ -104,7 +92,7 @@ class ContactProblem:
     p(x) 1.9 / 2.3 / 3.1 % body-fitted at 0.75 / 1 / 1.5 h, 3.9 / 3.4 % cut at 1 / 1.5 h, with
     traction "nodes"). traction: "nodes" (the law on each node's weighted mean gap) or "points"
     (the law at each point with the multipliers interpolated, `contact_set`; the kernel's eps_n
-    and eps_t are then POINTWISE_EPS0 and POINTWISE_EPS0_T times h / `contact_modulus`, and
+    and eps_t are then POINTWISE_EPS0 and POINTWISE_EPS0_T times h / E_c (eq 51), and
     eps0 relaxes the Uzawa step by min(1, eps_n / eps));
     default "points" with "augmented". multiplier_mass (augmented, P1, traction "points"):
     "hybrid" (default: zero weighted gap on the closed part of every node mostly in contact,
@@ -203,8 +191,8 @@ class ContactProblem:
 
         h = scene.h_contact
         self.band = band if band is not None else 2 * h
-        E_mean = np.mean([law.modulus for law in self.laws.values()])
-        self.eps_n = self.eps_t = eps0 * h / E_mean  # eq 51
+        E_c = contact_modulus(scene, self.laws, obstacles)
+        self.eps_n = self.eps_t = penalty_parameter(eps0, h, E_c)  # eq 51
         if multipliers == "default":
             multipliers = "P1" if enforcement == "augmented" else None
         if traction == "default":
@@ -229,13 +217,12 @@ class ContactProblem:
         relaxation, eps_t_start = 1.0, None
         if enforcement == "augmented" and multipliers is not None and traction == "points":
             # the point-wise regularisation is part of the discretisation; eps0 sets the step
-            E_c = contact_modulus(scene, self.laws, obstacles)
-            fine = (CONSISTENT_EPS0 if consistent else POINTWISE_EPS0) * h / E_c
+            fine = penalty_parameter(CONSISTENT_EPS0 if consistent else POINTWISE_EPS0, h, E_c)
             relaxation = min(1.0, fine / self.eps_n)
-            self.eps_n, self.eps_t = fine, POINTWISE_EPS0_T * h / E_c
+            self.eps_n, self.eps_t = fine, penalty_parameter(POINTWISE_EPS0_T, h, E_c)
             eps_t_start = self.eps_t
             if consistent:
-                self.eps_t = CONSISTENT_EPS0_T * h / E_c
+                self.eps_t = penalty_parameter(CONSISTENT_EPS0_T, h, E_c)
         if multiplier_length is None:
             multiplier_length = h * (
                 CONSISTENT_LENGTH if consistent else 1.5 if self.integration is not None else 1.0
