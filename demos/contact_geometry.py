@@ -22,7 +22,7 @@ import numpy as np
 
 import dolfinx_forms as df
 from dolfinx_forms.app import cli
-from dolfinx_forms.app.demo import run_case
+from dolfinx_forms.app.demo import Run
 from dolfinx_forms.solvers.newton import ContactSolverError
 
 OPTIONS = [  # option, kind, default[, help]
@@ -58,35 +58,6 @@ def parse(argv=None):
             f"(the contact region of eq 22 is empty, or outside the grid), got {args.gap}"
         )
     return args
-
-
-def scene(run):
-    """The block y < 0 and the cylinder of centre (0, R + g): level sets on one grid."""
-    p = run.params
-    R, w, n = p["R"], p["width"], int(np.ceil(2 * p["width"] / p["h"]))
-    grid = df.StructuredGrid.uniform([-w, -w / 2], [w, w / 2], [n, n // 2])
-    centre = np.array([0.0, R + run.params["gap"]])
-    block = df.levelset_from_shape(grid, df.Box([-4 * R, -4 * R], [4 * R, 0.0]))
-    cyl = df.levelset_from_shape(grid, df.Circle(centre, R))
-    return SimpleNamespace(grid=grid, centre=centre, block=block, cyl=cyl)
-
-
-def stages(run):
-    """Gamma_c (eqs 21-24), its points projected onto both bodies (eq 25), the gaps (eq 28)."""
-    sc = run.scene
-    with run.timer.phase("contact"):
-        s = df.contact_surface(sc.block, sc.cyl, eps=run.params["eps"])
-        pi = df.closest_point_projection(sc.block, s["points"])
-        pj = df.closest_point_projection(sc.cyl, s["points"])
-    if not (pi["converged"].all() and pj["converged"].all()):
-        k = np.flatnonzero(~(pi["converged"] & pj["converged"]))[0]
-        raise ContactSolverError(
-            f"closest-point projection failed at contact point {k} ({s['points'][k][0]:.6g}, "
-            f"{s['points'][k][1]:.6g}): status {int(pi['status'][k])}/{int(pj['status'][k])}"
-        )
-    zero = np.zeros_like(s["points"])
-    gaps = df.compute_gaps(pi["points"], pj["points"], zero, zero, s["normals"], s["tangents"])
-    run.data.update(s=s, pi=pi, pj=pj, g_n0=gaps["g_n0"])
 
 
 def evaluate(run):
@@ -151,8 +122,38 @@ SUMMARY = (
 
 
 def main(argv=None):
-    kw = dict(discretization="cut", files=files, summary=SUMMARY)  # no solver: no tractions
-    return run_case("contact_geometry", vars(parse(argv)), scene, None, stages, evaluate, **kw)
+    args = parse(argv)
+    with Run("contact_geometry", vars(args), discretization="cut", plot=False) as run:
+        # the scene: the block y < 0 and the cylinder of centre (0, R + g), level sets on a grid
+        R, w, n = args.R, args.width, int(np.ceil(2 * args.width / args.h))
+        with run.phase("mesh"):
+            grid = df.StructuredGrid.uniform([-w, -w / 2], [w, w / 2], [n, n // 2])
+            centre = np.array([0.0, R + args.gap])
+            block = df.levelset_from_shape(grid, df.Box([-4 * R, -4 * R], [4 * R, 0.0]))
+            cyl = df.levelset_from_shape(grid, df.Circle(centre, R))
+            run.scene = SimpleNamespace(grid=grid, centre=centre, block=block, cyl=cyl)
+
+        # the geometry: Gamma_c (eqs 21-24), its points projected onto both bodies (eq 25), the
+        # initial gaps (eq 28)
+        with run.phase("contact"):
+            s = df.contact_surface(block, cyl, eps=args.eps)
+            pi = df.closest_point_projection(block, s["points"])
+            pj = df.closest_point_projection(cyl, s["points"])
+        if not (pi["converged"].all() and pj["converged"].all()):
+            k = np.flatnonzero(~(pi["converged"] & pj["converged"]))[0]
+            raise ContactSolverError(
+                f"closest-point projection failed at contact point {k} ({s['points'][k][0]:.6g}, "
+                f"{s['points'][k][1]:.6g}): status {int(pi['status'][k])}/{int(pj['status'][k])}"
+            )
+        zero = np.zeros_like(s["points"])
+        gaps = df.compute_gaps(pi["points"], pj["points"], zero, zero, s["normals"], s["tangents"])
+        run.data.update(s=s, pi=pi, pj=pj, g_n0=gaps["g_n0"])
+
+        # the check: against the parabola and the exact gap (rank 0)
+        if run.rank0:
+            evaluate(run)
+        run.finish(SUMMARY, files=files)  # no solver: no tractions
+    return run.status
 
 
 if __name__ == "__main__":

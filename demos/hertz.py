@@ -24,7 +24,7 @@ import sys
 
 from dolfinx_forms.analysis import analytic, compare
 from dolfinx_forms.app import cli
-from dolfinx_forms.app.demo import run_case
+from dolfinx_forms.app.demo import Run
 from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.solvers.protocol import friction_on, reach_force
 from meshes.cut import hertz_cut_scene
@@ -110,60 +110,17 @@ def estimate(p):
     return E_star, analytic.hertz_line(p["load"], p["R"], E_star)[0]
 
 
-def scene(run):
-    """The block and the half-cylinder, mesh size h on the zone |x|, |y| < zone a."""
-    p, cut = run.params, run.params["discretization"] == "cut"
-    size = dict(R=p["R"], width=p["width"], depth=p["depth"], h=p["h"], zone=p["zone"])
-    size["zone"] *= estimate(p)[1]
-    size["band"] = band(p)  # rank 0 holds the cells of Gamma_c
-    # the far field coarsens with h, so that its error falls with h's (a fixed h_far: a floor)
-    size["h_far"] = p["h_far"] or min(p["R"] / 2, p["depth"] / 2, 100 * p["h"])
-    # body-fitted slope 0.5 instead: the same error at a/20 but a floor of 0.55 % from a/40 on
-    size["growth"] = p["grading"] or (2.0 if cut else 0.25)
-    if cut:  # graded grid, spacing h on the zone; cylinder cut
-        return hertz_cut_scene(run.comm, **size)
-    return hertz_scene(run.comm, **size, quads=p["quads"], mesher=p["mesher"])
-
-
-def problem(run):
-    """Block clamped at its bottom; the cylinder top held (moved by the stages); frictionless."""
-    p = run.params
-    run.loads = dict(x=Dirichlet("cylinder_top", 0, 0.0), y=Dirichlet("cylinder_top", 1, 0.0))
-    bcs = [Dirichlet("block_bottom", None, 0.0), run.loads["x"], run.loads["y"]]
-    return run.contact_problem(bcs, mu=0.0, band=band(p))
-
-
 def band(p):
     """The largest initial gap Gamma_c covers: --band, default the gap at x = 1.6 a."""
     return p["band"] or (1.6 * estimate(p)[1]) ** 2 / (2 * p["R"])
 
 
-def stages(run):
-    """Press the top down until the reaction is P (frictionless; the approach is solved for in
-    Newton with the equation "reaction = P"); then friction on and the top moved sideways
-    while the tangential reaction rises to Q = r mu P (monotonic loading, as Cattaneo-Mindlin
-    assumes)."""
-    p, pb, top = run.params, run.problem, run.loads
-    a, P, r = estimate(p)[1], p["load"], p["tangential"]
-    # the first guess: the rigid interference a^2 / (2R), whose overlap |x| < a is Hertz's
-    # contact: Newton starts from the right active set (3-4 iterations; a^2 / R: 9-10)
-    approach = -(a**2) / (2 * p["R"])
-    normal = reach_force(pb, top["y"], "block_bottom", 1, P, approach, steps=p["steps"])
-    if r == 0:
-        return [normal]
-    friction = friction_on(pb, p["mu"])
-    Q, probe = r * p["mu"] * P, 1e-3 * run.scene.h_contact  # probe: the full-stick stiffness
-    n = p["tangential_steps"]
-    tangential = reach_force(pb, top["x"], "cylinder_top", 0, Q, probe, 2e-3, n, monotone=True)
-    return [normal, friction, tangential]
-
-
-def evaluate(run):
+def evaluate(run, E_star):
     """Measured a, p0, p(x) (and the stick zone) against Hertz (and Cattaneo-Mindlin) at the
     computed loads: P the reaction at the block bottom, Q the one at the cylinder top."""
     p, pts, reaction = run.params, run.pts, run.reactions["block_bottom"]
     Q = run.reactions["cylinder_top"][0] if p["tangential"] > 0 else None
-    res, an, run.curves = compare.hertz(pts, abs(reaction[1]), p["R"], estimate(p)[0], p["mu"], Q)
+    res, an, run.curves = compare.hertz(pts, abs(reaction[1]), p["R"], E_star, p["mu"], Q)
     measured = compare.contact_results(pts, run.problem.mu)
     keys = ["contact_half_width", "contact_centre", "peak_pressure", "contact_force"]
     keys += ["stick_half_width"] if Q is not None else []
@@ -184,10 +141,49 @@ SUMMARY = (
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
     args.protocol = PROTOCOL
-    name, reactions = "mindlin" if args.tangential else "hertz", ["block_bottom", "cylinder_top"]
-    return run_case(
-        name, vars(args), scene, problem, stages, evaluate, reactions=reactions, summary=SUMMARY
-    )
+    p, cut = vars(args), args.discretization == "cut"
+    E_star, a = estimate(p)
+    with Run("mindlin" if args.tangential else "hertz", p) as run:
+        # the scene: the block and the half-cylinder, mesh size h on |x|, |y| < zone a
+        size = dict(R=args.R, width=args.width, depth=args.depth, h=args.h, zone=args.zone * a)
+        size["band"] = band(p)  # rank 0 holds the cells of Gamma_c
+        # the far field coarsens with h, so that its error falls with h's (fixed h_far: a floor)
+        size["h_far"] = args.h_far or min(args.R / 2, args.depth / 2, 100 * args.h)
+        # body-fitted slope 0.5 instead: the same error at a/20 but a floor of 0.55 % from a/40
+        size["growth"] = args.grading or (2.0 if cut else 0.25)
+        with run.phase("mesh"):
+            if cut:  # graded grid, spacing h on the zone; cylinder cut
+                run.scene = hertz_cut_scene(run.comm, **size)
+            else:
+                run.scene = hertz_scene(run.comm, **size, quads=args.quads, mesher=args.mesher)
+
+        # the problem: block clamped at its bottom, the cylinder top held (moved by the stages)
+        top_x, top_y = Dirichlet("cylinder_top", 0, 0.0), Dirichlet("cylinder_top", 1, 0.0)
+        bcs = [Dirichlet("block_bottom", None, 0.0), top_x, top_y]
+        pb = run.problem = run.contact_problem(bcs, mu=0.0, band=band(p))
+
+        # the run: the top pressed down until the reaction is P (frictionless; the approach
+        # solved for in Newton with the equation "reaction = P"), from the rigid interference
+        # a^2 / 2R, whose overlap |x| < a is Hertz's contact (3-4 iterations; a^2 / R: 9-10).
+        # Then friction on and the top moved sideways while the tangential reaction rises to
+        # Q = r mu P (monotonic loading, as Cattaneo-Mindlin assumes).
+        P, r = args.load, args.tangential
+        guess = -(a**2) / (2 * args.R)
+        run.records = [reach_force(pb, top_y, "block_bottom", 1, P, guess, steps=args.steps)]
+        if r > 0:
+            run.records.append(friction_on(pb, args.mu))
+            Q, probe = r * args.mu * P, 1e-3 * run.scene.h_contact  # the full-stick stiffness
+            n = args.tangential_steps
+            tangential = reach_force(pb, top_x, "cylinder_top", 0, Q, probe, 2e-3, n, monotone=True)
+            run.records.append(tangential)
+        run.measure(reactions=["block_bottom", "cylinder_top"])
+
+        # the check: a, p0, p(x) (and the stick zone) against Hertz (and Cattaneo-Mindlin) at
+        # the computed loads (rank 0)
+        if run.rank0:
+            evaluate(run, E_star)
+        run.finish(SUMMARY)
+    return run.status
 
 
 if __name__ == "__main__":

@@ -29,7 +29,7 @@ import numpy as np
 
 from dolfinx_forms.analysis import analytic, compare, post
 from dolfinx_forms.app import cli
-from dolfinx_forms.app.demo import run_case
+from dolfinx_forms.app.demo import Run
 from dolfinx_forms.fem.boundary import nearest_vertex_marker
 from dolfinx_forms.io.output import plot_lines
 from dolfinx_forms.fem.boundary import Dirichlet
@@ -79,53 +79,6 @@ def parse(argv):
     a = p.parse_args(argv)
     cli.check_scale(p, a, SIZE, "square")
     return a
-
-
-def scene(run):
-    """Gmsh bodies below and above the interface, or both on one uniform grid that it cuts."""
-    p = run.params
-    if p["discretization"] == "conforming":
-        return incline_scene(run.comm, h=p["h"], quads=p["quads"], **LINE)
-    s = incline_cut_scene(run.comm, h=p["h"], **LINE)
-    run.metrics["mesh"]["cut_cells"] = cut_counts(s)
-    return s
-
-
-def problem(run):
-    """Top and bottom held (SUPPORTS); the uniform state of the penalised problem."""
-    p = run.params
-    ld = run.loads = dict(top_y=Dirichlet("upper_top", 1, 0.0), top_x=Dirichlet("upper_top", 0))
-    if p["supports"] == "uniaxial":
-        ld["bottom_x"] = Dirichlet("lower_bottom", 0, 0.0)
-    else:  # rollers, with the bottom vertex nearest to x = X0 held
-        bottom = lambda x: np.isclose(x[1], 0.0)  # noqa: E731
-        ld["bottom_x"] = Dirichlet(nearest_vertex_marker(run.scene.mesh, (X0, 0.0), bottom), 0)
-    bcs = [ld["top_y"], Dirichlet("lower_bottom", 1, 0.0), ld["top_x"], ld["bottom_x"]]
-    pb = run.contact_problem(bcs, mu=0.0, band=p["h"])
-    state = (p["E"], p["nu"], p["displacement"], SIZE, SLOPE, pb.eps_n, pb.eps_t)
-    run.data["ref"] = analytic.inclined_uniaxial_state(*state)
-    return pb
-
-
-def stages(run):
-    """Friction from the start (zero plastic slip at u = 0); the top moved down, and with the
-    uniaxial supports top and bottom moved horizontally as the uniform state."""
-    p, ld, ref = run.params, run.loads, run.data["ref"]
-
-    def u_x(offset):  # of the uniform state, at the coordinates x of a condition's dofs
-        return lambda x: ref["exx"] * (x[0] - X0) + offset
-
-    loads, targets = [ld["top_y"]], [-p["displacement"]]
-    if p["supports"] == "uniaxial":
-        loads, targets = loads + [ld["top_x"], ld["bottom_x"]], targets + [u_x(ref["gx"]), u_x(0.0)]
-    return [
-        friction_on(run.problem, p["mu"]),
-        ramp(run.problem, loads, targets, p["steps"], label="incline"),
-    ]
-
-
-def collect(run):  # every rank: the total tangential jump g_t (elastic + plastic), on rank 0
-    run.data["g_t"] = post.tangential_jumps(run.problem)
 
 
 def evaluate(run):
@@ -182,8 +135,48 @@ def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
     params = dict(vars(args), quads=args.quads or args.discretization == "cut", **LINE)
     params.update(boundary_conditions=SUPPORTS[args.supports], slip_threshold=THRESHOLD)
-    outputs = dict(reactions=["upper_top"], collect=collect, files=files, summary=summary)
-    return run_case("incline", params, scene, problem, stages, evaluate, **outputs)
+    with Run("incline", params) as run:
+        # the scene: gmsh bodies below and above the interface, or one uniform grid it cuts
+        with run.phase("mesh"):
+            if args.discretization == "conforming":
+                run.scene = incline_scene(run.comm, h=args.h, quads=args.quads, **LINE)
+            else:
+                run.scene = incline_cut_scene(run.comm, h=args.h, **LINE)
+                run.metrics["mesh"]["cut_cells"] = cut_counts(run.scene)
+
+        # the problem: top and bottom held (SUPPORTS); the uniform state of the penalised one
+        top_y, top_x = Dirichlet("upper_top", 1, 0.0), Dirichlet("upper_top", 0)
+        if args.supports == "uniaxial":
+            bottom_x = Dirichlet("lower_bottom", 0, 0.0)
+        else:  # rollers, with the bottom vertex nearest to x = X0 held
+            bottom = lambda x: np.isclose(x[1], 0.0)  # noqa: E731
+            bottom_x = Dirichlet(nearest_vertex_marker(run.scene.mesh, (X0, 0.0), bottom), 0)
+        bcs = [top_y, Dirichlet("lower_bottom", 1, 0.0), top_x, bottom_x]
+        pb = run.problem = run.contact_problem(bcs, mu=0.0, band=args.h)
+        state = (args.E, args.nu, args.displacement, SIZE, SLOPE, pb.eps_n, pb.eps_t)
+        ref = run.data["ref"] = analytic.inclined_uniaxial_state(*state)
+
+        # the run: friction from the start (zero plastic slip at u = 0); the top moved down,
+        # and with the uniaxial supports top and bottom moved horizontally as the uniform state
+        def u_x(offset):  # of the uniform state, at the coordinates x of a condition's dofs
+            return lambda x: ref["exx"] * (x[0] - X0) + offset
+
+        loads, targets = [top_y], [-args.displacement]
+        if args.supports == "uniaxial":
+            loads, targets = loads + [top_x, bottom_x], targets + [u_x(ref["gx"]), u_x(0.0)]
+        run.records = [
+            friction_on(pb, args.mu),
+            ramp(pb, loads, targets, args.steps, label="incline"),
+        ]
+        run.measure(reactions=["upper_top"])
+        # the total tangential jump g_t (elastic + plastic), gathered on rank 0
+        run.data["g_t"] = post.tangential_jumps(pb)
+
+        # the check (rank 0)
+        if run.rank0:
+            evaluate(run)
+        run.finish(summary, files=files)
+    return run.status
 
 
 if __name__ == "__main__":

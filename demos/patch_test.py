@@ -23,7 +23,7 @@ import numpy as np
 
 from dolfinx_forms.analysis import compare
 from dolfinx_forms.app import cli
-from dolfinx_forms.app.demo import run_case
+from dolfinx_forms.app.demo import Run
 from dolfinx_forms.solvers.protocol import ramp
 from meshes.cut import patch_cut_scene
 from meshes.patch import patch_dirichlet, patch_scene
@@ -73,48 +73,6 @@ def parse(argv):
     return a
 
 
-def scene(run):
-    """Two blocks: a uniform grid cut by the interface, or gmsh blocks meeting at y = 0.5."""
-    p, nx = run.params, round(1.0 / run.params["h"])
-    run.metrics["mesh"]["h_contact"] = p["h"]
-    if p["discretization"] == "cut":
-        return patch_cut_scene(run.comm, n=nx, interface=p["interface"])
-    return patch_scene(
-        run.comm, nx=nx, ny=max(1, nx // 2), quads=not p["triangles"], nx_upper=p["upper_cells"]
-    )
-
-
-def problem(run):
-    """Bottom held vertically, one point of each block horizontally; the top moved down."""
-    bcs = patch_dirichlet(run.params["displacement"])
-    run.loads["top"] = bcs[1]  # upper_top, u_y
-    # body-fitted: the level-set grid passes through the blocks' corners, as the meshes do
-    # (a corner inside a grid cell bends Gamma_c there: the clip at the ends moves by ~h / 40)
-    conforming = run.params["discretization"] == "conforming"
-    origin = (0.0, 0.0) if conforming else None
-    return run.contact_problem(bcs, band=0.5 * run.params["h"], pair_grid_origin=origin)
-
-
-def stages(run):
-    return [ramp(run.problem, run.loads["top"], -run.params["displacement"], label="patch")]
-
-
-def evaluate(run):
-    """Uniform pressure (against the penalised and the exact value) and zero shear. The
-    augmented Lagrangian's answer is the exact one (its compliance is 0)."""
-    p, pts = run.params, run.pts
-    eps_n = 0.0 if run.problem.contact.augmented else run.problem.eps_n
-    res, an, run.curves = compare.patch(pts, p["E"], p["nu"], p["displacement"], 1.0, eps_n)
-    run.results.update(
-        reaction=run.reactions["upper_top"],
-        **res,
-        shear_max=float(np.max(np.abs(pts["p_t"]))),
-        contact_length=float(np.sum(pts["w"])),
-    )
-    run.analytic.update(an)
-    run.plot_kw = dict(title="patch test", xlabel="x", ylabel="traction")
-
-
 SUMMARY = (
     "patch test: pressure {results[pressure_mean]:.10f} (penalised exact "
     "{analytic[pressure_penalised]:.10f}, eps -> 0: {analytic[pressure]:.10f}), max deviation "
@@ -124,8 +82,46 @@ SUMMARY = (
 
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
-    outputs = dict(reactions=["upper_top"], summary=SUMMARY)
-    return run_case("patch", vars(args), scene, problem, stages, evaluate, **outputs)
+    with Run("patch", vars(args)) as run:
+        # the scene: a uniform grid cut by the interface, or gmsh blocks meeting at y = 0.5
+        nx, cut = round(1.0 / args.h), args.discretization == "cut"
+        run.metrics["mesh"]["h_contact"] = args.h
+        with run.phase("mesh"):
+            if cut:
+                run.scene = patch_cut_scene(run.comm, n=nx, interface=args.interface)
+            else:
+                ny, quads = max(1, nx // 2), not args.triangles
+                run.scene = patch_scene(run.comm, nx, ny, quads, nx_upper=args.upper_cells)
+
+        # the problem: bottom held vertically, one point of each block horizontally; body-fitted,
+        # the level-set grid passes through the blocks' corners, as the meshes do (a corner inside
+        # a grid cell bends Gamma_c there: the clip at the ends moves by ~h / 40)
+        bcs = patch_dirichlet(args.displacement)
+        origin = None if cut else (0.0, 0.0)
+        run.problem = run.contact_problem(bcs, band=0.5 * args.h, pair_grid_origin=origin)
+
+        # the run: the top moved down
+        run.records = [ramp(run.problem, bcs[1], -args.displacement, label="patch")]
+        run.measure(reactions=["upper_top"])
+
+        # the check: uniform pressure (against the penalised and the exact value: the augmented
+        # Lagrangian's compliance is 0) and zero shear
+        if run.rank0:
+            pts = run.pts
+            eps_n = 0.0 if run.problem.contact.augmented else run.problem.eps_n
+            res, an, run.curves = compare.patch(
+                pts, args.E, args.nu, args.displacement, 1.0, eps_n
+            )
+            run.results.update(
+                reaction=run.reactions["upper_top"],
+                **res,
+                shear_max=float(np.max(np.abs(pts["p_t"]))),
+                contact_length=float(np.sum(pts["w"])),
+            )
+            run.analytic.update(an)
+            run.plot_kw = dict(title="patch test", xlabel="x", ylabel="traction")
+        run.finish(SUMMARY)
+    return run.status
 
 
 if __name__ == "__main__":

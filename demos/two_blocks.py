@@ -31,7 +31,7 @@ import ufl
 
 from dolfinx_forms.analysis import compare, post
 from dolfinx_forms.app import cli
-from dolfinx_forms.app.demo import run_case
+from dolfinx_forms.app.demo import Run
 from dolfinx_forms.io.output import write_columns
 from dolfinx_forms.fem.boundary import Dirichlet, Traction
 from dolfinx_forms.solvers.protocol import friction_on, ramp
@@ -72,49 +72,6 @@ def parse(argv):
     cli.check_scale(p, a, SIZES["width_lower"], "block", displacement=False)
     cli.check_scale(p, a, 2 * SIZES["height"], "stack")
     return a
-
-
-def scene(run):
-    """Gmsh blocks, or both blocks on one uniform grid whose cells the interface y = 10 cuts."""
-    p = run.params
-    if p["discretization"] == "conforming":
-        return two_blocks_scene(run.comm, h=p["h"], quads=p["quads"], **SIZES)
-    s = two_blocks_cut_scene(run.comm, h=p["h"], **SIZES)
-    run.metrics["mesh"]["cut_cells"] = cut_counts(s)
-    return s
-
-
-def problem(run):
-    """Lower bottom clamped, upper top held; the side tractions p (x, y) (10 - y) MPa."""
-    y = ufl.SpatialCoordinate(run.scene.mesh)[1]
-    side = y * (SIZES["height"] - y)
-    run.loads = dict(
-        top_y=Dirichlet("upper_top", 1, 0.0),
-        left=Traction("lower_left", ufl.as_vector((PX * side, PY * side))),
-        right=Traction("lower_right", ufl.as_vector((-PX * side, PY * side))),
-    )
-    fixed = [Dirichlet("lower_bottom", None, 0.0), Dirichlet("upper_top", 0, 0.0)]
-    return run.contact_problem(
-        [*fixed, run.loads["top_y"]],
-        mu=0.0,
-        band=run.params["h"],
-        tractions=[run.loads["left"], run.loads["right"]],
-    )
-
-
-def stages(run):
-    """Friction from the start (zero plastic slip at u = 0), then displacement and side loads
-    ramped together."""
-    p, ld = run.params, run.loads
-    loads, targets = [ld["top_y"], ld["left"], ld["right"]], [-p["displacement"], 1.0, 1.0]
-    return [
-        friction_on(run.problem, p["mu"]),
-        ramp(run.problem, loads, targets, p["steps"], label="blocks"),
-    ]
-
-
-def collect(run):  # every rank: the stress along y = 5
-    run.data["sigma_x"] = post.stress_at_points(run.problem, LINE)
 
 
 def evaluate(run):
@@ -162,8 +119,41 @@ def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
     params = dict(vars(args), quads=args.quads or args.discretization == "cut", **SIZES)
     params.update(side_traction=SIDE_TRACTION, supports=SUPPORTS)
-    outputs = dict(reactions=["upper_top"], collect=collect, files=files, summary=summary)
-    return run_case("blocks", params, scene, problem, stages, evaluate, **outputs)
+    with Run("blocks", params) as run:
+        # the scene: gmsh blocks, or both blocks on one uniform grid whose cells y = 10 cuts
+        with run.phase("mesh"):
+            if args.discretization == "conforming":
+                run.scene = two_blocks_scene(run.comm, h=args.h, quads=args.quads, **SIZES)
+            else:
+                run.scene = two_blocks_cut_scene(run.comm, h=args.h, **SIZES)
+                run.metrics["mesh"]["cut_cells"] = cut_counts(run.scene)
+
+        # the problem: lower bottom clamped, upper top held; side tractions p (x, y) (10 - y)
+        y = ufl.SpatialCoordinate(run.scene.mesh)[1]
+        side = y * (SIZES["height"] - y)
+        top_y = Dirichlet("upper_top", 1, 0.0)
+        left = Traction("lower_left", ufl.as_vector((PX * side, PY * side)))
+        right = Traction("lower_right", ufl.as_vector((-PX * side, PY * side)))
+        fixed = [Dirichlet("lower_bottom", None, 0.0), Dirichlet("upper_top", 0, 0.0)]
+        run.problem = run.contact_problem(
+            [*fixed, top_y], mu=0.0, band=args.h, tractions=[left, right]
+        )
+
+        # the run: friction from the start (zero plastic slip at u = 0), then the displacement
+        # and the side loads ramped together
+        loads, targets = [top_y, left, right], [-args.displacement, 1.0, 1.0]
+        run.records = [
+            friction_on(run.problem, args.mu),
+            ramp(run.problem, loads, targets, args.steps, label="blocks"),
+        ]
+        run.measure(reactions=["upper_top"])
+        run.data["sigma_x"] = post.stress_at_points(run.problem, LINE)  # collective
+
+        # the check (rank 0: the contact points live there)
+        if run.rank0:
+            evaluate(run)
+        run.finish(summary, files=files)
+    return run.status
 
 
 if __name__ == "__main__":

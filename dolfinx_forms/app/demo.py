@@ -1,40 +1,34 @@
 """The run skeleton shared by the demos and the scene runner (runner.py).
 
-A demo states the physics (its scene and problem), the protocol (its stages) and the check
-(its evaluation); `run_case` does the rest, the same way for every demo:
+A demo reads top to bottom, the skeleton called at each step:
 
-    metrics record and phase timer -> scene (timed as "mesh") -> problem -> stages
-    -> reactions and contact points -> mesh and solver blocks of metrics.json
-    -> the demo's collective post-processing -> evaluation (rank 0) -> timer stop
-    -> one atomic folder (folders.py): solution.xdmf, tractions.csv, tractions.png, the demo's
-       own files, metrics.json -> console summary and "results in ..."
+    with Run("patch", vars(args)) as run:          # metrics record, phase timer, plot worker
+        with run.phase("mesh"):
+            run.scene = patch_cut_scene(run.comm, n=8)
+        top = Dirichlet("upper_top", 1, 0.0)
+        run.problem = run.contact_problem([..., top], band=0.05)
+        run.records = [protocol.ramp(run.problem, top, -0.01)]
+        run.measure(reactions=["upper_top"])       # reactions, contact points, mesh and solver
+        if run.rank0:                              # the check: the points live on rank 0
+            run.results.update(...); run.analytic.update(...); run.curves = {...}
+        run.finish(summary="patch test: pressure {results[pressure_mean]:.6g}")
+    return run.status
 
-A solver failure (ContactSolverError) in the stages prints one line on stderr (rank 0),
-writes nothing and gives exit status 1. Every callback receives the :class:`Run`:
-
-    def scene(run):      return patch_cut_scene(run.comm, n=8)          # timed as "mesh"
-    def problem(run):    run.loads["top"] = Dirichlet("upper_top", 1, 0.0)
-                         return run.contact_problem([..., run.loads["top"]], band=0.05)
-    def stages(run):     return [protocol.ramp(run.problem, run.loads["top"], -0.01)]
-    def evaluate(run):   run.results.update(...); run.analytic.update(...); run.curves = {...}
-    summary = "patch test: pressure {results[pressure_mean]:.6g}"  # or a function of run
-
-    params = dict(vars(args), derived=...)   # metrics.json "parameters"; out, force from it
-    sys.exit(run_case("patch", params, scene, problem, stages, evaluate,
-                      reactions=["upper_top"], summary=summary))
-
-The parts `compute` (everything up to the timer stop; raises ContactSolverError) and `write`
-(the atomic folder) are what runner.run uses.
+`finish` stops the timer, shares the metrics with every rank, writes one atomic folder
+(folders.py: solution.xdmf, tractions.csv, tractions.png, the demo's own files, metrics.json
+last) and prints the warnings, the summary and "results in ...". A solver failure
+(ContactSolverError) anywhere in the block prints one line on stderr (rank 0), writes nothing
+and leaves `run.status` 1. `compute` and `write` are the same steps for runner.run, which is
+handed its scene, problem and stages as functions of the description.
 """
 
 import sys
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from dolfinx_forms.io.results import PhaseTimer, new_metrics
 from dolfinx_forms.solvers.newton import ContactSolverError
 
-__all__ = ["Run", "run_case", "compute", "write", "traction_plot", "problem_options"]
+__all__ = ["Run", "compute", "write", "traction_plot", "problem_options"]
 
 # parameters that Run.contact_problem passes on: {parameter: ContactProblem argument}
 PROBLEM_OPTIONS = {
@@ -57,24 +51,51 @@ def problem_options(params):
     return {arg: params[k] for k, arg in PROBLEM_OPTIONS.items() if k in params}
 
 
-@dataclass
 class Run:
-    """The state of one run, handed to every callback of `run_case`."""
+    """One run: its metrics record and timer, then what the demo adds (scene, problem,
+    records, reactions, contact points, curves of the default plot). A context manager: a
+    ContactSolverError inside ends the run with one line and status 1 (module doc)."""
 
-    name: str  # metrics.json "benchmark"
-    discretization: str  # "conforming" or "cut"
-    comm: object
-    metrics: dict  # the metrics.json record (new_metrics); on every rank after `compute`
-    timer: PhaseTimer
-    scene: object = None  # build_scene's result
-    problem: object = None  # build_problem's result (None: no solver, e.g. a geometry demo)
-    loads: dict = field(default_factory=dict)  # named loads (build_problem fills it)
-    records: list = field(default_factory=list)  # the stages' StageRecords (protocol.py)
-    reactions: dict = field(default_factory=dict)  # {boundary: [Fx, Fy(, Fz)]}, every rank
-    pts: dict | None = None  # the contact points (output.gather_points), rank 0 only
-    data: dict = field(default_factory=dict)  # the demo's own values (collect, evaluate)
-    curves: dict = field(default_factory=dict)  # analytic curves of the default plot
-    plot_kw: dict = field(default_factory=dict)  # title, xlabel, ylabel of the default plot
+    def __init__(self, name, params, *, discretization=None, comm=None, plot=True, prog=None):
+        from mpi4py import MPI
+
+        self.name = name  # metrics.json "benchmark"
+        self.comm = MPI.COMM_WORLD if comm is None else comm
+        # metrics.json's "conforming" or "cut" (default params["discretization"])
+        self.discretization = discretization or params.get("discretization", "conforming")
+        self.metrics = new_metrics(name, self.discretization, params)
+        self.timer = PhaseTimer(self.metrics)
+        self.prog = prog or Path(sys.argv[0]).name
+        self.scene = None
+        self.problem = None  # None: no solver (a geometry demo)
+        self.loads = {}  # named loads
+        self.records = []  # the stages' StageRecords (protocol.py)
+        self.reactions = {}  # {boundary: [Fx, Fy(, Fz)]}, every rank
+        self.pts = None  # the contact points (output.gather_points), rank 0 only
+        self.data = {}  # the demo's own values
+        self.curves = {}  # analytic curves of the default plot
+        self.plot_kw = {}  # title, xlabel, ylabel of the default plot
+        self.status = None  # the exit status, once the run ended
+        self._plot = plot and self.rank0
+        if self._plot:  # matplotlib's import and clean-up overlap the run
+            from dolfinx_forms.io import output
+
+            output.start_plot_worker()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, error, tb):
+        if self._plot:
+            from dolfinx_forms.io import output
+
+            output.stop_plot_worker()
+        if kind is not None and issubclass(kind, ContactSolverError):
+            if self.rank0:
+                sys.stderr.write(f"{self.prog}: {error}\n")
+            self.status = 1
+            return True
+        return False
 
     @property
     def params(self):
@@ -92,6 +113,10 @@ class Run:
     def rank0(self):
         return self.comm.rank == 0
 
+    def phase(self, name):
+        """Time a block as one of the phases of metrics.json (results.PHASES)."""
+        return self.timer.phase(name)
+
     def contact_problem(self, dirichlet=(), **kw):
         """A ContactProblem on the scene, timed by the run's timer, with the options that the
         parameters name: E, nu (every body linear elastic), mu, eps0, degree, ghost_penalty,
@@ -104,6 +129,49 @@ class Run:
         opts.update(problem_options(p))
         opts.update(kw)
         return ContactProblem(self.scene, opts.pop("materials"), **opts)
+
+    def measure(self, reactions=()):
+        """After the stages: the reactions at `reactions` (boundary names), the contact points
+        (on rank 0), the mesh and solver blocks of metrics.json. Collective. Without a problem
+        (a geometry demo) the mesh block is the demo's to fill."""
+        from dolfinx_forms.io.output import gather_points
+        from dolfinx_forms.solvers.problem import solver_metrics
+
+        problem = self.problem
+        if problem is None:
+            return
+        self.reactions = {b: [float(f) for f in problem.reaction(b)] for b in reactions}
+        self.pts = gather_points(problem)
+        mesh, block = self.scene.mesh, self.metrics["mesh"]
+        h = block["h_contact"]  # the demo may state its own
+        block.update(
+            h_contact=self.scene.h_contact if h is None else h,
+            num_cells=mesh.topology.index_map(mesh.topology.dim).size_global,
+            num_dofs=problem.num_dofs,
+        )
+        self.metrics["solver"] = solver_metrics(problem)
+
+    def close(self):
+        """Stop the timer and give every rank rank 0's metrics (the evaluation is rank 0's)."""
+        self.timer.stop()
+        self.metrics = self.comm.bcast(self.metrics if self.rank0 else None, root=0)
+
+    def finish(self, summary=None, *, out=None, force=None, **kw):
+        """close, then the result folder (`write`: out default params["out"], force
+        params["force"]; kw: plot, files, solution, tractions), then on rank 0 the warnings,
+        the summary (a function of the run, or a format string filled with the metrics,
+        "{results[peak_pressure]:.5g}") and "results in ...". Sets status 0."""
+        self.close()
+        out = self.params["out"] if out is None else out
+        force = self.params.get("force", False) if force is None else force
+        folder = write(self, out, force, **kw)
+        if self.rank0:
+            for w in self.metrics.get("solver", {}).get("warnings", []):
+                print(f"WARNING: {w}")
+            if summary is not None:
+                print(summary(self) if callable(summary) else summary.format(**self.metrics))
+            print(f"results in {folder}")
+        self.status = 0
 
 
 def traction_plot(run, path):
@@ -126,46 +194,21 @@ def compute(
     collect=None,
     comm=None,
 ):
-    """Scene, problem, stages, reactions at `reactions` (boundary names), contact points,
-    mesh and solver blocks, collect(run) on every rank, evaluate(run) on rank 0, timer stop;
-    the metrics are then broadcast to every rank. Returns the Run. Raises ContactSolverError.
-    discretization: metrics.json's (default params["discretization"], else "conforming").
-
-    build_scene may set metrics["mesh"]["h_contact"] (default: scene.h_contact).
-    Without build_problem (a geometry demo) the stages still run (stages(run), timed by the
-    demo) and the mesh block is the demo's to fill."""
-    from mpi4py import MPI
-
-    from dolfinx_forms.io.output import gather_points
-    from dolfinx_forms.solvers.problem import solver_metrics
-
-    comm = MPI.COMM_WORLD if comm is None else comm
-    discretization = discretization or params.get("discretization", "conforming")
-    metrics = new_metrics(name, discretization, params)
-    run = Run(name, discretization, comm, metrics, PhaseTimer(metrics))
-    with run.timer.phase("mesh"):
+    """The steps of a demo's `with Run(...)` block with the parts given as functions of the run
+    (runner.run): scene (timed as "mesh"), problem, stages, `Run.measure`, collect(run) on every
+    rank, evaluate(run) on rank 0, `Run.close`. Returns the Run. Raises ContactSolverError."""
+    run = Run(name, params, discretization=discretization, comm=comm, plot=False)
+    with run.phase("mesh"):
         run.scene = build_scene(run)
     if build_problem is not None:
         run.problem = build_problem(run)
     run.records = list((stages(run) if stages is not None else None) or [])
-    problem = run.problem
-    if problem is not None:
-        run.reactions = {b: [float(f) for f in problem.reaction(b)] for b in reactions}
-        run.pts = gather_points(problem)
-        mesh = run.scene.mesh
-        h = metrics["mesh"]["h_contact"]  # build_scene may state its own
-        metrics["mesh"].update(
-            h_contact=run.scene.h_contact if h is None else h,
-            num_cells=mesh.topology.index_map(mesh.topology.dim).size_global,
-            num_dofs=problem.num_dofs,
-        )
-        metrics["solver"] = solver_metrics(problem)
+    run.measure(reactions)
     if collect is not None:
         collect(run)
     if evaluate is not None and run.rank0:
         evaluate(run)
-    run.timer.stop()
-    run.metrics = comm.bcast(metrics if run.rank0 else None, root=0)
+    run.close()
     return run
 
 
@@ -200,68 +243,3 @@ def write(
                 files(run, folder)
             write_metrics(folder, run.metrics)
     return Path(out).resolve()
-
-
-def run_case(
-    name,
-    params,
-    build_scene,
-    build_problem=None,
-    stages=None,
-    evaluate=None,
-    *,
-    discretization=None,
-    out=None,
-    force=None,
-    reactions=(),
-    collect=None,
-    plot=traction_plot,
-    files=None,
-    summary=None,
-    comm=None,
-    prog=None,
-):
-    """One demo run (module doc): `compute`, then `write` into `out` (default params["out"],
-    force: params["force"]), then the summary (printed on rank 0: summary(run), or a format
-    string filled with the metrics, "{results[peak_pressure]:.5g}") and "results in
-    ...". Returns the exit status: 0, or 1 after a ContactSolverError (one line "prog: message"
-    on stderr, nothing written). params: every input after defaults (metrics.json's
-    "parameters"), usually dict(vars(args), derived values...)."""
-    from mpi4py import MPI
-
-    from dolfinx_forms.io import output
-
-    prog = prog or Path(sys.argv[0]).name
-    out = params["out"] if out is None else out
-    force = params.get("force", False) if force is None else force
-    rank0 = (comm or MPI.COMM_WORLD).rank == 0
-    if plot is traction_plot and rank0:  # matplotlib's import and clean-up overlap the run
-        output.start_plot_worker()
-    try:
-        try:
-            run = compute(
-                name,
-                params,
-                build_scene,
-                build_problem,
-                stages,
-                evaluate,
-                discretization=discretization,
-                reactions=reactions,
-                collect=collect,
-                comm=comm,
-            )
-        except ContactSolverError as e:
-            if rank0:
-                sys.stderr.write(f"{prog}: {e}\n")
-            return 1
-        folder = write(run, out, force, plot=plot, files=files)
-    finally:
-        output.stop_plot_worker()
-    if run.rank0:
-        for w in run.metrics.get("solver", {}).get("warnings", []):
-            print(f"WARNING: {w}")
-        if summary is not None:
-            print(summary(run) if callable(summary) else summary.format(**run.metrics))
-        print(f"results in {folder}")
-    return 0
