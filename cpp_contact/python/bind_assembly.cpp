@@ -3,31 +3,40 @@
 // contact/contact_kernel.h; here element blocks go into a PETSc Mat by local block indices
 // and the coupling blocks into a dolfinx SparsityPattern.
 #include "array.h"
+#include "la.h"
 #include <caster_petsc.h>
 #include <contact/contact_kernel.h>
-#include <dolfinx/la/SparsityPattern.h>
-#include <petscmat.h>
 #include <pybind11/stl.h>
-#include <stdexcept>
 #include <string>
 
 namespace py = pybind11;
-using contact::python::as_span;
-using contact::python::carray;
+using contact::python::any;
+using contact::python::Arg;
+using contact::python::check_range;
+using contact::python::flat;
+using contact::python::Indices;
+using contact::python::input;
+using contact::python::pattern_blocks;
+using contact::python::petsc_check;
 using contact::python::to_numpy;
-using iarray = py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>;
 
 namespace {
-template <typename T>
-std::vector<T> copy_of(const py::array_t<T, py::array::c_style | py::array::forcecast>& a) {
-  return std::vector<T>(a.data(), a.data() + a.size());
+/// @brief A copy of a checked float64 input as a std::vector.
+std::vector<double> f64_vector(const Arg& arg, const py::handle& h,
+                               std::initializer_list<py::ssize_t> pattern) {
+  const auto a = input<double>(arg, h, pattern);
+  return std::vector<double>(a.data(), a.data() + a.size());
 }
 
-/// Throw with the PETSc function named on a non-zero error code.
-void petsc_check(PetscErrorCode ierr, const char* where) {
-  if (ierr != 0)
-    throw std::runtime_error(std::string("PETSc error ") + std::to_string(ierr) + " in " + where);
+/// @brief Check the block dofs of a quadrature against the number of blocks they index.
+void check_dofs(const char* function, const contact::ContactQuadrature& q, std::int64_t blocks,
+                const char* what) {
+  const std::string i = std::string("quadrature.dofs_i (blocks of ") + what + ")",
+                    j = std::string("quadrature.dofs_j (blocks of ") + what + ")";
+  check_range(Arg{function, i.c_str()}, q.dofs_i, 0, blocks);
+  check_range(Arg{function, j.c_str()}, q.dofs_j, 0, blocks);
 }
+
 } // namespace
 
 void bind_assembly(py::module_& m) {
@@ -36,27 +45,36 @@ void bind_assembly(py::module_& m) {
   py::class_<ContactQuadrature>(m, "ContactQuadrature",
                                 "Contact points of a body pair with the cells and basis values at "
                                 "their closest points on each body (reference configuration)")
-      .def(py::init([](const carray& weights, const carray& normals, const carray& tangents,
-                       const carray& g_n0, const iarray& dofs_i, const iarray& dofs_j,
-                       const carray& basis_i, const carray& basis_j) {
-             if (dofs_i.ndim() != 2 or dofs_j.ndim() != 2)
-               throw std::invalid_argument("dofs_i, dofs_j: expected arrays of shape (nq, nodes)");
+      .def(py::init([](const py::object& weights, const py::object& normals,
+                       const py::object& tangents, const py::object& g_n0, const py::object& dofs_i,
+                       const py::object& dofs_j, const py::object& basis_i,
+                       const py::object& basis_j) {
+             const char* f = "ContactQuadrature";
              ContactQuadrature q;
-             q.nodes_i = int(dofs_i.shape(1));
-             q.nodes_j = int(dofs_j.shape(1));
-             q.weights = copy_of(weights);
-             q.normals = copy_of(normals);
-             q.tangents = copy_of(tangents);
-             q.g_n0 = copy_of(g_n0);
-             q.dofs_i = copy_of(dofs_i);
-             q.dofs_j = copy_of(dofs_j);
-             q.basis_i = copy_of(basis_i);
-             q.basis_j = copy_of(basis_j);
+             q.weights = f64_vector(Arg{f, "weights"}, weights, {any});
+             const auto nq = py::ssize_t(q.weights.size());
+             q.normals = f64_vector(Arg{f, "normals"}, normals, {nq, 2});
+             q.tangents = f64_vector(Arg{f, "tangents"}, tangents, {nq, 2});
+             q.g_n0 = f64_vector(Arg{f, "g_n0"}, g_n0, {nq});
+             const Indices di(Arg{f, "dofs_i"}, dofs_i, {nq, any});
+             const Indices dj(Arg{f, "dofs_j"}, dofs_j, {nq, any});
+             // block dofs index a local vector that assemble_contact checks them against
+             di.check_range(0, std::numeric_limits<std::int32_t>::max());
+             dj.check_range(0, std::numeric_limits<std::int32_t>::max());
+             q.nodes_i = int(di.shape(1));
+             q.nodes_j = int(dj.shape(1));
+             q.dofs_i = di.vector();
+             q.dofs_j = dj.vector();
+             q.basis_i = f64_vector(Arg{f, "basis_i"}, basis_i, {nq, q.nodes_i});
+             q.basis_j = f64_vector(Arg{f, "basis_j"}, basis_j, {nq, q.nodes_j});
              q.validate();
              return q;
            }),
            py::arg("weights"), py::arg("normals"), py::arg("tangents"), py::arg("g_n0"),
-           py::arg("dofs_i"), py::arg("dofs_j"), py::arg("basis_i"), py::arg("basis_j"))
+           py::arg("dofs_i"), py::arg("dofs_j"), py::arg("basis_i"), py::arg("basis_j"),
+           "weights (nq,), normals and tangents (nq, 2), g_n0 (nq,) float64; dofs_i (nq, "
+           "nodes_i) and dofs_j (nq, nodes_j) block dofs, int32 or int64 (>= 0); basis_i, "
+           "basis_j float64 of the shapes of dofs_i, dofs_j. ValueError names a bad argument.")
       .def("__len__", &ContactQuadrature::size)
       .def_property_readonly("weights",
                              [](const ContactQuadrature& q) {
@@ -74,24 +92,28 @@ void bind_assembly(py::module_& m) {
             return to_numpy(std::vector<double>(q.u_j_prescribed),
                             {py::ssize_t(q.u_j_prescribed.size() / 2), 2});
           },
-          [](ContactQuadrature& q, const carray& v) {
-            if (v.size() != 0 and
-                (v.ndim() != 2 or v.shape(0) != py::ssize_t(q.size()) or v.shape(1) != 2))
-              throw std::invalid_argument("u_j_prescribed: expected shape (nq, 2) or empty");
-            q.u_j_prescribed = copy_of(v);
+          [](ContactQuadrature& q, const py::object& v) {
+            const Arg arg{"ContactQuadrature", "u_j_prescribed"};
+            const auto a = input<double>(arg, v);
+            if (a.size() != 0)
+              contact::python::check_shape(arg, a, {py::ssize_t(q.size()), 2});
+            q.u_j_prescribed.assign(a.data(), a.data() + a.size());
           },
           "(nq, 2) displacement of side j at P_j not carried by dofs (rigid obstacle motion), "
           "added to u_j(P_j) in the gaps; empty: none")
       .def(
           "set_multiplier_nodes",
-          [](ContactQuadrature& q, const iarray& nodes, const carray& weights) {
-            if (nodes.ndim() != 2 or nodes.shape(1) != 2 or weights.ndim() != 2 or
-                weights.shape(1) != 2)
-              throw std::invalid_argument("nodes, weights: expected arrays of shape (nq, 2)");
+          [](ContactQuadrature& q, const py::object& nodes, const py::object& weights) {
+            const char* f = "set_multiplier_nodes";
+            const auto nq = py::ssize_t(q.size());
+            const Indices n(Arg{f, "nodes"}, nodes, {nq, 2});
+            // -1: no second node; the law points are 0 .. max(nodes)
+            n.check_range(-1, std::numeric_limits<std::int32_t>::max());
+            std::vector<double> w = f64_vector(Arg{f, "weights"}, weights, {nq, 2});
             std::vector<std::int32_t> old_n = q.mult_nodes;
             std::vector<double> old_w = q.mult_weights;
-            q.mult_nodes = copy_of(nodes);
-            q.mult_weights = copy_of(weights);
+            q.mult_nodes = n.vector();
+            q.mult_weights = std::move(w);
             try {
               q.validate();
             } catch (...) {
@@ -122,6 +144,7 @@ void bind_assembly(py::module_& m) {
   m.def(
       "insert_coupling",
       [](dolfinx::la::SparsityPattern& pattern, const ContactQuadrature& q) {
+        check_dofs("insert_coupling", q, pattern_blocks(pattern), "the pattern's index map");
         const contact::CouplingBlocks c = contact::coupling_dofs(q);
         for (std::size_t s = 0; s + 1 < c.offsets.size(); ++s) {
           std::span<const std::int32_t> d(c.dofs.data() + c.offsets[s],
@@ -138,6 +161,9 @@ void bind_assembly(py::module_& m) {
       [](Mat A, const ContactQuadrature& q) {
         // PETSc squeezes preallocated but unused entries out at the first final assembly:
         // explicit zeros keep the contact blocks in the matrix for every later iteration.
+        const PetscInt blocks = contact::python::local_block_rows(A);
+        if (blocks >= 0)
+          check_dofs("add_coupling_zeros", q, blocks, "A's local-to-global map");
         const contact::CouplingBlocks c = contact::coupling_dofs(q);
         for (std::size_t s = 0; s + 1 < c.offsets.size(); ++s) {
           const auto nd = PetscInt(c.offsets[s + 1] - c.offsets[s]);
@@ -153,19 +179,32 @@ void bind_assembly(py::module_& m) {
 
   m.def(
       "assemble_contact",
-      [](const ContactQuadrature& q, double eps_n, double eps_t, double mu, const carray& u,
-         const carray& gtp_old, std::optional<py::array_t<double, py::array::c_style>> b,
-         std::optional<Mat> A, bool finite_difference, double fd_step, double closed_gap,
-         std::optional<carray> g_n_shift) {
+      [](const ContactQuadrature& q, double eps_n, double eps_t, double mu, const py::object& u,
+         const py::object& gtp_old, const py::object& b, std::optional<Mat> A,
+         bool finite_difference, double fd_step, double closed_gap, const py::object& g_n_shift) {
+        const char* f = "assemble_contact";
+        q.validate();
+        const auto ua = input<double>(Arg{f, "u"}, u, {any});
+        if (ua.size() % 2 != 0)
+          contact::python::fail(Arg{f, "u"}, "expected an even length (block size 2), got " +
+                                                 std::to_string(ua.size()));
+        const auto na = py::ssize_t(q.num_law_points());
+        // gtp_old is not read without friction (may be empty)
+        const auto gtp = input<double>(Arg{f, "gtp_old"}, gtp_old, {mu > 0 ? na : any});
+        // every dof indexes u (and b): checked once here, not in the kernel's loops
+        check_dofs(f, q, ua.size() / 2, "u");
         std::span<double> bs;
-        if (b) {
-          if (b->size() != u.size())
-            throw std::invalid_argument("b: expected the size of u");
-          bs = std::span<double>(b->mutable_data(), std::size_t(b->size()));
-        }
+        if (!b.is_none())
+          bs = contact::python::output<double>(Arg{f, "b"}, b, std::size_t(ua.size()));
+        std::optional<contact::python::Array<double>> shift;
+        if (!g_n_shift.is_none())
+          shift = input<double>(Arg{f, "g_n_shift"}, g_n_shift, {na});
         contact::BlockInserter insert;
         if (A) {
           Mat mat = *A;
+          const PetscInt blocks = contact::python::local_block_rows(mat);
+          if (blocks >= 0)
+            check_dofs(f, q, blocks, "A's local-to-global map");
           insert = [mat](std::span<const std::int32_t> dofs, std::span<const double> Ke) {
             const auto nd = PetscInt(dofs.size());
             petsc_check(MatSetValuesBlockedLocal(mat, nd, dofs.data(), nd, dofs.data(), Ke.data(),
@@ -176,10 +215,9 @@ void bind_assembly(py::module_& m) {
         const auto mode = finite_difference ? contact::TangentMode::finite_difference
                                             : contact::TangentMode::exact;
         contact::ContactPointState s = contact::assemble_contact(
-            q, contact::CoulombPenalty{eps_n, eps_t, mu}, as_span(u, "u"),
-            as_span(gtp_old, "gtp_old"), bs, insert, mode, fd_step, closed_gap,
-            g_n_shift ? as_span(*g_n_shift, "g_n_shift") : std::span<const double>());
-        const auto nq = py::ssize_t(q.size()), na = py::ssize_t(q.num_law_points());
+            q, contact::CoulombPenalty{eps_n, eps_t, mu}, flat(ua), flat(gtp), bs, insert, mode,
+            fd_step, closed_gap, shift ? flat(*shift) : std::span<const double>());
+        const auto nq = py::ssize_t(q.size());
         auto int8 = [](const std::vector<contact::ContactState>& v) {
           std::vector<std::int8_t> out(v.size());
           for (std::size_t p = 0; p < v.size(); ++p)
@@ -213,5 +251,7 @@ void bind_assembly(py::module_& m) {
       "g_n, g_t, tau_n, tau_t, state (int8 ContactState), of law points (multiplier nodes, or "
       "the points) law_g_n, law_g_t, law_tau_n, law_tau_t, law_state, and their gtp_trial "
       "(None when mu == 0). gtp_old and g_n_shift (eps_n lambda_n of the augmented "
-      "Lagrangian, added to the gap the law sees, or None) are per law point.");
+      "Lagrangian, added to the gap the law sees, or None) are per law point. Arrays are "
+      "float64, C-contiguous (b also writeable, never copied); every block dof must index u "
+      "(and A): ValueError names a bad argument.");
 }

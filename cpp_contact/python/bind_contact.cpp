@@ -12,8 +12,12 @@
 #include <vector>
 
 namespace py = pybind11;
-using contact::python::as_span;
-using contact::python::carray;
+using contact::python::any;
+using contact::python::Arg;
+using contact::python::check_shape;
+using contact::python::fail;
+using contact::python::flat;
+using contact::python::input;
 using contact::python::to_numpy;
 
 namespace {
@@ -42,27 +46,28 @@ void bind_contact(py::module_& m) {
 
   m.def(
       "return_mapping",
-      [](const carray& g_n, const carray& g_t, const carray& gtp_old, double eps_n, double eps_t,
-         double mu) {
-        if (g_n.ndim() != 1)
-          throw std::invalid_argument("g_n: expected an array of shape (n,)");
+      [](const py::object& g_n_in, const py::object& g_t_in, const py::object& gtp_old_in,
+         double eps_n, double eps_t, double mu) {
+        const char* f = "return_mapping";
+        const auto g_n = input<double>(Arg{f, "g_n"}, g_n_in, {any});
         const py::ssize_t n = g_n.shape(0);
-        if ((g_t.ndim() != 1 and g_t.ndim() != 2) or g_t.shape(0) != n) {
-          throw std::invalid_argument("g_t: expected shape (n,) or (n, tdim) with n = len(g_n) = " +
-                                      std::to_string(n));
-        }
+        const auto g_t = input<double>(Arg{f, "g_t"}, g_t_in);
+        if ((g_t.ndim() != 1 and g_t.ndim() != 2) or g_t.shape(0) != n)
+          fail(Arg{f, "g_t"}, "expected shape (n,) or (n, tdim) with n = len(g_n) = " +
+                                  std::to_string(n) + ", got " + contact::python::shape_str(g_t));
+        const auto gtp_old = input<double>(Arg{f, "gtp_old"}, gtp_old_in);
         if (gtp_old.ndim() != g_t.ndim() or
-            !std::equal(g_t.shape(), g_t.shape() + g_t.ndim(), gtp_old.shape())) {
-          throw std::invalid_argument("gtp_old: expected the shape of g_t");
-        }
+            !std::equal(g_t.shape(), g_t.shape() + g_t.ndim(), gtp_old.shape()))
+          fail(Arg{f, "gtp_old"}, "expected the shape of g_t " + contact::python::shape_str(g_t) +
+                                      ", got " + contact::python::shape_str(gtp_old));
         // The C++ core rejects tdim not in {1, 2}
         const int tdim = g_t.ndim() == 1 ? 1 : int(g_t.shape(1));
         const std::size_t nn = n, td = std::max(tdim, 0), nd = 1 + td;
 
         std::vector<double> tau_n(nn), tau_t(nn * td), gtp(nn * td), D(nn * nd * nd);
         std::vector<ContactState> state(nn);
-        contact::return_mapping({eps_n, eps_t, mu}, tdim, as_span(g_n, "g_n"), as_span(g_t, "g_t"),
-                                as_span(gtp_old, "gtp_old"), tau_n, tau_t, gtp, state, D);
+        contact::return_mapping({eps_n, eps_t, mu}, tdim, flat(g_n), flat(g_t), flat(gtp_old),
+                                tau_n, tau_t, gtp, state, D);
         std::vector<std::int8_t> s8(nn);
         std::ranges::transform(state, s8.begin(), [](ContactState s) { return std::int8_t(s); });
 
@@ -107,16 +112,15 @@ Arrays are copies of shape (n,) for tdim 1 and (n, tdim) otherwise.)")
       .def_property(
           "trial",
           [](const FrictionHistory& h) { return history_array(h.trial(), h.size(), h.tdim()); },
-          [](FrictionHistory& h, const carray& v) {
-            const auto shape = tangential_shape(h.size(), h.tdim());
-            if (std::size_t(v.ndim()) != shape.size() or
-                !std::equal(shape.begin(), shape.end(), v.shape())) {
-              throw std::invalid_argument("trial: expected shape (n,) for tdim 1 or (n, tdim), "
-                                          "n = " +
-                                          std::to_string(h.size()));
-            }
-            auto s = as_span(v, "trial");
-            std::ranges::copy(s, h.trial().begin());
+          [](FrictionHistory& h, const py::object& v) {
+            const Arg arg{"FrictionHistory", "trial"};
+            const auto a = input<double>(arg, v);
+            const auto n = py::ssize_t(h.size());
+            if (h.tdim() == 1)
+              check_shape(arg, a, {n});
+            else
+              check_shape(arg, a, {n, py::ssize_t(h.tdim())});
+            std::ranges::copy(flat(a), h.trial().begin());
           },
           "Copy of the trial plastic slip (Algorithm 1, g_t^{p,(k+1)}); assignable from numpy")
       .def("commit", &FrictionHistory::commit, "Accept the trial slip (converged step)")
@@ -125,15 +129,19 @@ Arrays are copies of shape (n,) for tdim 1 and (n, tdim) otherwise.)")
 
   m.def(
       "compute_gaps",
-      [](const carray& p_i, const carray& p_j, const carray& u_i, const carray& u_j,
-         const carray& normals, const carray& tangents) {
-        auto pi = as_span(p_i, "p_i", 2), pj = as_span(p_j, "p_j", 2), ui = as_span(u_i, "u_i", 2),
-             uj = as_span(u_j, "u_j", 2), nrm = as_span(normals, "normals", 2),
-             tng = as_span(tangents, "tangents", 2);
-        // n from p_i; the core checks that every other input has the same number of rows
-        const py::ssize_t n = p_i.shape(0);
+      [](const py::object& p_i, const py::object& p_j, const py::object& u_i, const py::object& u_j,
+         const py::object& normals, const py::object& tangents) {
+        const char* f = "compute_gaps";
+        const auto pi = input<double>(Arg{f, "p_i"}, p_i, {any, 2});
+        const py::ssize_t n = pi.shape(0);
+        const auto pj = input<double>(Arg{f, "p_j"}, p_j, {n, 2}),
+                   ui = input<double>(Arg{f, "u_i"}, u_i, {n, 2}),
+                   uj = input<double>(Arg{f, "u_j"}, u_j, {n, 2}),
+                   nrm = input<double>(Arg{f, "normals"}, normals, {n, 2}),
+                   tng = input<double>(Arg{f, "tangents"}, tangents, {n, 2});
         std::vector<double> g_n0(n), j_int(n), g_n(n), g_t(n);
-        contact::compute_gaps(pi, pj, ui, uj, nrm, tng, g_n0, j_int, g_n, g_t);
+        contact::compute_gaps(flat(pi), flat(pj), flat(ui), flat(uj), flat(nrm), flat(tng), g_n0,
+                              j_int, g_n, g_t);
         py::dict out;
         out["g_n0"] = to_numpy(std::move(g_n0), {n});
         out["j_int"] = to_numpy(std::move(j_int), {n});
