@@ -5,24 +5,24 @@
 #include <string>
 
 namespace py = pybind11;
-using contact::python::carray;
+using contact::python::Arg;
+using contact::python::Array;
+using contact::python::fail;
+using contact::python::flat;
+using contact::python::input;
 using contact::python::to_numpy;
 
 namespace {
 
-/// @brief Dimension of a box array of shape (n, 2, d) or (n, 2 d), d >= 1.
-int box_dim(const carray& boxes, const char* name) {
+/// @brief Dimension of a float64 box array of shape (n, 2, d) or (n, 2 d), d >= 1.
+int box_dim(const Array<double>& boxes, const Arg& arg) {
   if (boxes.ndim() == 3 and boxes.shape(1) == 2 and boxes.shape(2) >= 1)
     return int(boxes.shape(2));
   if (boxes.ndim() == 2 and boxes.shape(1) >= 2 and boxes.shape(1) % 2 == 0)
     return int(boxes.shape(1) / 2);
-  throw std::invalid_argument(std::string(name) +
-                              ": expected an array of shape (n, 2, d) or (n, 2 d) with rows "
-                              "[lo_0, .., lo_{d-1}, hi_0, .., hi_{d-1}]");
-}
-
-std::span<const double> flat(const carray& a) {
-  return std::span<const double>(a.data(), std::size_t(a.size()));
+  fail(arg, "expected an array of shape (n, 2, d) or (n, 2 d) with rows [lo_0, .., lo_{d-1}, "
+            "hi_0, .., hi_{d-1}], got " +
+                contact::python::shape_str(boxes));
 }
 
 py::array_t<std::int32_t> pairs_array(std::vector<std::int32_t>&& p) {
@@ -35,8 +35,10 @@ py::array_t<std::int32_t> pairs_array(std::vector<std::int32_t>&& p) {
 void bind_broad_phase(py::module_& m) {
   m.def(
       "candidate_pairs",
-      [](const carray& boxes, double inflate) {
-        const int dim = box_dim(boxes, "boxes");
+      [](const py::object& boxes_in, double inflate) {
+        const Arg arg{"candidate_pairs", "boxes"};
+        const auto boxes = input<double>(arg, boxes_in);
+        const int dim = box_dim(boxes, arg);
         std::vector<std::int32_t> p;
         {
           py::gil_scoped_release release;
@@ -52,11 +54,14 @@ void bind_broad_phase(py::module_& m) {
       "or inflate < 0.");
   m.def(
       "candidate_pairs_between",
-      [](const carray& a, const carray& b, double inflate) {
-        const int da = box_dim(a, "boxes_a"), db = box_dim(b, "boxes_b");
+      [](const py::object& a_in, const py::object& b_in, double inflate) {
+        const Arg arg_a{"candidate_pairs_between", "boxes_a"},
+            arg_b{"candidate_pairs_between", "boxes_b"};
+        const auto a = input<double>(arg_a, a_in), b = input<double>(arg_b, b_in);
+        const int da = box_dim(a, arg_a), db = box_dim(b, arg_b);
         if (da != db)
-          throw std::invalid_argument("boxes_b: dimension " + std::to_string(db) +
-                                      " differs from boxes_a's " + std::to_string(da));
+          fail(arg_b,
+               "dimension " + std::to_string(db) + " differs from boxes_a's " + std::to_string(da));
         std::vector<std::int32_t> p;
         {
           py::gil_scoped_release release;

@@ -12,8 +12,11 @@
 
 namespace py = pybind11;
 using namespace contact;
-using contact::python::as_span;
-using contact::python::carray;
+using contact::python::any;
+using contact::python::Arg;
+using contact::python::flat;
+using contact::python::Indices;
+using contact::python::input;
 using contact::python::to_numpy;
 
 namespace {
@@ -56,8 +59,10 @@ py::dict surface_dict(ContactSurface&& s) {
 void bind_geometry(py::module_& m) {
   py::class_<StructuredGrid>(m, "StructuredGrid",
                              "Tensor-product 2D grid, uniform or graded; nodes x-fastest")
-      .def(py::init([](const carray& x, const carray& y) {
-             auto sx = as_span(x, "x"), sy = as_span(y, "y");
+      .def(py::init([](const py::object& x, const py::object& y) {
+             const auto ax = input<double>(Arg{"StructuredGrid", "x"}, x, {any}),
+                        ay = input<double>(Arg{"StructuredGrid", "y"}, y, {any});
+             const auto sx = flat(ax), sy = flat(ay);
              return StructuredGrid({sx.begin(), sx.end()}, {sy.begin(), sy.end()});
            }),
            py::arg("x"), py::arg("y"), "Grid from strictly increasing node coordinates per axis")
@@ -96,8 +101,10 @@ void bind_geometry(py::module_& m) {
           "Node coordinates, shape (num_nodes, 2), x-fastest")
       .def(
           "locate",
-          [](const StructuredGrid& g, const carray& pts) {
-            auto x = as_span(pts, "points", 2);
+          [](const StructuredGrid& g, const py::object& points) {
+            const auto pts =
+                input<double>(Arg{"StructuredGrid.locate", "points"}, points, {any, 2});
+            const auto x = flat(pts);
             std::vector<std::int64_t> c(x.size() / 2, -1);
             for (std::size_t p = 0; p < c.size(); ++p)
               if (auto ij = g.locate(std::span<const double, 2>(x.data() + 2 * p, 2)))
@@ -107,8 +114,15 @@ void bind_geometry(py::module_& m) {
           py::arg("points"), "Cell index of each point ((n, 2) -> (n,)), -1 outside the grid");
 
   py::class_<LevelSet>(m, "LevelSet", "Level set on a grid (eq 17), C1 bicubic Hermite interpolant")
-      .def(py::init([](const StructuredGrid& g, const carray& v) {
-             auto s = as_span(v, "values");
+      .def(py::init([](const StructuredGrid& g, const py::object& v) {
+             const Arg arg{"LevelSet", "values"};
+             const auto a = input<double>(arg, v);
+             const auto ny = py::ssize_t(g.num_nodes(1)), nx = py::ssize_t(g.num_nodes(0));
+             if (a.ndim() == 1)
+               contact::python::check_shape(arg, a, {nx * ny});
+             else
+               contact::python::check_shape(arg, a, {ny, nx});
+             const auto s = flat(a);
              return LevelSet(g, {s.begin(), s.end()});
            }),
            py::arg("grid"), py::arg("values"), "From node values, flat x-fastest or shape (ny, nx)")
@@ -123,8 +137,9 @@ void bind_geometry(py::module_& m) {
           "Node values as a (ny, nx) copy")
       .def(
           "evaluate",
-          [](const LevelSet& l, const carray& pts) {
-            auto x = as_span(pts, "points", 2);
+          [](const LevelSet& l, const py::object& points) {
+            const auto pts = input<double>(Arg{"LevelSet.evaluate", "points"}, points, {any, 2});
+            const auto x = flat(pts);
             std::vector<double> v(x.size() / 2), g(x.size());
             l.evaluate(x, v, g);
             const auto n = py::ssize_t(v.size());
@@ -135,8 +150,9 @@ void bind_geometry(py::module_& m) {
   py::class_<Shape, std::shared_ptr<Shape>>(m, "Shape", "Analytic body: phi < 0 inside")
       .def(
           "__call__",
-          [](const Shape& s, const carray& pts) {
-            auto x = as_span(pts, "points", 2);
+          [](const Shape& s, const py::object& points) {
+            const auto pts = input<double>(Arg{"Shape.__call__", "points"}, points, {any, 2});
+            const auto x = flat(pts);
             std::vector<double> v(x.size() / 2);
             s.evaluate(x, v);
             return to_numpy(std::move(v), {py::ssize_t(v.size())});
@@ -149,8 +165,10 @@ void bind_geometry(py::module_& m) {
            py::arg("a"), py::arg("b"), py::arg("angle") = 0.0)
       .def(
           "closest_point",
-          [](const Ellipse& e, const carray& pts) {
-            auto x = as_span(pts, "points", 2);
+          [](const Ellipse& e, const py::object& points) {
+            const auto pts =
+                input<double>(Arg{"Ellipse.closest_point", "points"}, points, {any, 2});
+            const auto x = flat(pts);
             std::vector<double> q(x.size());
             for (std::size_t p = 0; p < x.size() / 2; ++p) {
               auto c = e.closest_point({x[2 * p], x[2 * p + 1]});
@@ -162,8 +180,9 @@ void bind_geometry(py::module_& m) {
   py::class_<Box, Shape, std::shared_ptr<Box>>(m, "Box").def(
       py::init<std::array<double, 2>, std::array<double, 2>>(), py::arg("lo"), py::arg("hi"));
   py::class_<Polygon, Shape, std::shared_ptr<Polygon>>(m, "Polygon")
-      .def(py::init([](const carray& v) {
-             auto s = as_span(v, "vertices", 2);
+      .def(py::init([](const py::object& v) {
+             const auto a = input<double>(Arg{"Polygon", "vertices"}, v, {any, 2});
+             const auto s = flat(a);
              return std::make_shared<Polygon>(std::vector<double>(s.begin(), s.end()));
            }),
            py::arg("vertices"));
@@ -188,8 +207,9 @@ void bind_geometry(py::module_& m) {
         "Sample an analytic shape at the grid nodes");
   m.def(
       "levelset_from_polyline",
-      [](const StructuredGrid& g, const carray& v, int band) {
-        return levelset_from_polyline(g, as_span(v, "vertices", 2), band);
+      [](const StructuredGrid& g, const py::object& v, int band) {
+        const auto a = input<double>(Arg{"levelset_from_polyline", "vertices"}, v, {any, 2});
+        return levelset_from_polyline(g, flat(a), band);
       },
       py::arg("grid"), py::arg("vertices"), py::arg("band") = 3,
       "Signed distance to a closed polyline: exact in a band, fast sweeping beyond");
@@ -203,9 +223,11 @@ void bind_geometry(py::module_& m) {
       .value("left_grid", ProjectionStatus::left_grid);
   m.def(
       "closest_point_projection",
-      [](const LevelSet& phi, const carray& pts, double rtol, int max_iterations, double grad_tol) {
+      [](const LevelSet& phi, const py::object& points, double rtol, int max_iterations,
+         double grad_tol) {
+        const auto pts = input<double>(Arg{"closest_point_projection", "points"}, points, {any, 2});
         ProjectionResult r = closest_point_projection(
-            phi, as_span(pts, "points", 2), ProjectionOptions{rtol, max_iterations, grad_tol});
+            phi, flat(pts), ProjectionOptions{rtol, max_iterations, grad_tol});
         return projection_dict(std::move(r));
       },
       py::arg("phi"), py::arg("points"), py::arg("rtol") = 1e-10, py::arg("max_iterations") = 50,
@@ -214,11 +236,11 @@ void bind_geometry(py::module_& m) {
       "points (n, 2), status (int8, ProjectionStatus), iterations, converged (bool)");
   m.def(
       "closest_point_projection",
-      [](const Shape& shape, const carray& pts, double length_scale, double rtol,
+      [](const Shape& shape, const py::object& points, double length_scale, double rtol,
          int max_iterations, double grad_tol) {
-        ProjectionResult r =
-            closest_point_projection(shape, as_span(pts, "points", 2), length_scale,
-                                     ProjectionOptions{rtol, max_iterations, grad_tol});
+        const auto pts = input<double>(Arg{"closest_point_projection", "points"}, points, {any, 2});
+        ProjectionResult r = closest_point_projection(
+            shape, flat(pts), length_scale, ProjectionOptions{rtol, max_iterations, grad_tol});
         return projection_dict(std::move(r));
       },
       py::arg("shape"), py::arg("points"), py::arg("length_scale"), py::arg("rtol") = 1e-10,
@@ -251,11 +273,15 @@ void bind_geometry(py::module_& m) {
       "normals (body i -> j) and tangents");
   m.def(
       "segment_quadrature",
-      [](const LevelSet& phi_int, const py::array_t<double, py::array::c_style>& segments,
-         const py::array_t<std::int32_t, py::array::c_style>& cells, int num_gauss) {
-        ContactSurface s = segment_quadrature(
-            phi_int, std::span<const double>(segments.data(), std::size_t(segments.size())),
-            std::span<const std::int32_t>(cells.data(), std::size_t(cells.size())), num_gauss);
+      [](const LevelSet& phi_int, const py::object& segments_in, const py::object& cells_in,
+         int num_gauss) {
+        const char* f = "segment_quadrature";
+        const Indices cells(Arg{f, "cells"}, cells_in, {any});
+        // a segment's cell indexes the grid's cells
+        cells.check_range(0, std::int64_t(phi_int.grid().num_cells()));
+        const auto segments =
+            input<double>(Arg{f, "segments"}, segments_in, {py::ssize_t(cells.size()), 2, 2});
+        ContactSurface s = segment_quadrature(phi_int, flat(segments), cells.flat(), num_gauss);
         return surface_dict(std::move(s));
       },
       py::arg("phi_int"), py::arg("segments"), py::arg("cells"), py::arg("num_gauss") = 2,

@@ -8,33 +8,43 @@
 
 namespace py = pybind11;
 using namespace contact;
-using contact::python::as_span;
-using contact::python::carray;
+using contact::python::any;
+using contact::python::Arg;
+using contact::python::fail;
+using contact::python::flat;
+using contact::python::Indices;
+using contact::python::input;
 using contact::python::to_numpy;
 
 namespace {
-using iarray = py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>;
-
-CellLocator make_locator(const carray& x, const iarray& cells,
-                         const std::optional<iarray>& subset) {
+CellLocator make_locator(const py::object& x_in, const py::object& cells_in,
+                         const py::object& subset_in) {
+  const char* f = "CellLocator";
+  const auto x = input<double>(Arg{f, "x"}, x_in);
   if (x.ndim() != 2 or (x.shape(1) != 2 and x.shape(1) != 3))
-    throw std::invalid_argument("x: expected an array of shape (nv, 2) or (nv, 3)");
+    fail(Arg{f, "x"},
+         "expected an array of shape (nv, 2) or (nv, 3), got " + contact::python::shape_str(x));
+  const Indices cells(Arg{f, "cells"}, cells_in);
   if (cells.ndim() != 2 or (cells.shape(1) != 3 and cells.shape(1) != 4))
-    throw std::invalid_argument("cells: expected an array of shape (nc, 3) (triangles) or "
-                                "(nc, 4) (quadrilaterals)");
-  if (subset and subset->ndim() != 1)
-    throw std::invalid_argument("subset: expected a 1D array of cell indices");
-  std::span<const std::int32_t> c(cells.data(), std::size_t(cells.size()));
+    fail(Arg{f, "cells"},
+         "expected an array of shape (nc, 3) (triangles) or (nc, 4) (quadrilaterals), got " +
+             contact::python::shape_str(cells.array()));
+  // vertex indices index the rows of x
+  cells.check_range(0, x.shape(0));
   std::vector<std::int32_t> all;
+  std::optional<Indices> subset;
   std::span<const std::int32_t> s;
-  if (subset)
-    s = std::span<const std::int32_t>(subset->data(), std::size_t(subset->size()));
-  else {
+  if (!subset_in.is_none()) {
+    subset.emplace(Arg{f, "subset"}, subset_in, std::initializer_list<py::ssize_t>{any});
+    // cell indices index the rows of cells
+    subset->check_range(0, cells.shape(0));
+    s = subset->flat();
+  } else {
     all.resize(std::size_t(cells.shape(0)));
     std::iota(all.begin(), all.end(), 0);
     s = all;
   }
-  return CellLocator(as_span(x, "x"), int(x.shape(1)), c, int(cells.shape(1)), s);
+  return CellLocator(flat(x), int(x.shape(1)), cells.flat(), int(cells.shape(1)), s);
 }
 } // namespace
 
@@ -53,8 +63,9 @@ void bind_location(py::module_& m) {
       .def_property_readonly("bin_size", &CellLocator::bin_size, "Bin size along x and y")
       .def(
           "locate",
-          [](const CellLocator& loc, const carray& pts, double max_distance) {
-            auto x = as_span(pts, "points", 2);
+          [](const CellLocator& loc, const py::object& points, double max_distance) {
+            const auto pts = input<double>(Arg{"CellLocator.locate", "points"}, points, {any, 2});
+            const auto x = flat(pts);
             LocatedPoints r;
             {
               py::gil_scoped_release release;

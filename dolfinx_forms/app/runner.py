@@ -91,7 +91,7 @@ def _check_scene(scene, spec):
             raise SpecError(f"boundaries[{i}]", f"{b['name']!r} marks no facet of the mesh")
         if b["body"] is not None:
             body = scene.bodies[names.index(b["body"])]
-            mid = compute_midpoints(scene.mesh, tdim - 1, facets)[:, :2]
+            mid = np.ascontiguousarray(compute_midpoints(scene.mesh, tdim - 1, facets)[:, :2])
             tol = 1e-6 * scene.h_contact
             inside = bool(len(facets)) and bool(np.any(np.asarray(body.shape(mid)) <= tol))
             if not comm.allreduce(inside, op=MPI.LOR):
