@@ -42,7 +42,7 @@ def test_linear_fields_reproduced(dim):
     assert r["neighbours"].dtype == np.int32 and np.all(r["neighbours"] >= dim + 1)
     assert np.all(r["rcond"] >= 1e-8) and np.all(r["widening"] >= 1)
     # A single field (n,) gives (k,) values, the same as column 0.
-    r1 = mls.project(field(src)[:, 0], tgt)
+    r1 = mls.project(np.ascontiguousarray(field(src)[:, 0]), tgt)
     assert r1["values"].shape == (len(tgt),)
     np.testing.assert_array_equal(r1["values"], r["values"][:, 0])
 

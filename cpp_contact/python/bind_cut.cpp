@@ -2,16 +2,18 @@
 // Cut cells: the kernels' addresses for custom integrals in dolfinx Forms, their coefficient
 // layout, vectorised cut quadrature (tests, diagnostics), and the ghost-penalty couplings.
 #include "array.h"
+#include "la.h"
 #include <contact/contour.h>
 #include <contact/cut_cell.h>
 #include <cstdint>
-#include <dolfinx/la/SparsityPattern.h>
 #include <limits>
 #include <pybind11/stl.h>
 
 namespace py = pybind11;
-using contact::python::as_span;
-using contact::python::carray;
+using contact::python::any;
+using contact::python::Arg;
+using contact::python::flat;
+using contact::python::input;
 using contact::python::to_numpy;
 namespace cut = contact::cut;
 
@@ -36,8 +38,9 @@ void bind_cut(py::module_& m) {
       "Offsets of the packed coefficients the cut kernels read (see contact/cut_cell.h)");
   m.def(
       "cut_quadrature",
-      [](const carray& phi, int degree) {
-        const auto p = as_span(phi, "phi", 4);
+      [](const py::object& phi, int degree) {
+        const auto phi_a = input<double>(Arg{"cut_quadrature", "phi"}, phi, {any, 4});
+        const auto p = flat(phi_a);
         const std::size_t n = p.size() / 4;
         std::vector<double> pts, wts;
         std::vector<std::int64_t> offsets(n + 1, 0);
@@ -57,8 +60,9 @@ void bind_cut(py::module_& m) {
       "weights (m,) (the full reference square has weight 1)");
   m.def(
       "inside_fraction",
-      [](const carray& phi) {
-        const auto p = as_span(phi, "phi", 4);
+      [](const py::object& phi) {
+        const auto phi_a = input<double>(Arg{"inside_fraction", "phi"}, phi, {any, 4});
+        const auto p = flat(phi_a);
         std::vector<double> f(p.size() / 4);
         for (std::size_t c = 0; c < f.size(); ++c)
           f[c] = cut::inside_fraction(std::span<const double, 4>(p.data() + 4 * c, 4));
@@ -67,8 +71,9 @@ void bind_cut(py::module_& m) {
       py::arg("phi"), "Inside area fraction of each cell, phi (n, 4) in tensor order");
   m.def(
       "cell_contours",
-      [](const carray& phi) {
-        const auto p = as_span(phi, "phi", 4);
+      [](const py::object& phi) {
+        const auto phi_a = input<double>(Arg{"cell_contours", "phi"}, phi, {any, 4});
+        const auto p = flat(phi_a);
         const std::size_t n = p.size() / 4;
         std::vector<double> t(4 * n);
         std::vector<std::int8_t> seg(4 * n, -1), ns(n);
@@ -98,11 +103,15 @@ void bind_cut(py::module_& m) {
       "edges (4, 2)");
   m.def(
       "cut_moment_weights",
-      [](const carray& phi, const carray& points) {
-        const auto p = as_span(phi, "phi", 4);
-        if (points.ndim() != 2 or points.shape(1) != 2 or points.shape(0) == 0)
-          throw std::invalid_argument("points: expected an array of shape (nq, 2), nq > 0");
-        const std::span<const double> x(points.data(), std::size_t(points.size()));
+      [](const py::object& phi, const py::object& points) {
+        const char* f = "cut_moment_weights";
+        const auto phi_a = input<double>(Arg{f, "phi"}, phi, {any, 4});
+        const auto p = flat(phi_a);
+        const auto pts = input<double>(Arg{f, "points"}, points, {any, 2}, "(nq, 2), nq > 0");
+        if (pts.shape(0) == 0)
+          contact::python::fail(Arg{f, "points"}, "expected an array of shape (nq, 2), nq > 0, "
+                                                  "got (0, 2)");
+        const std::span<const double> x = flat(pts);
         const std::size_t n = p.size() / 4, nq = x.size() / 2;
         std::vector<double> w(n * nq);
         for (std::size_t c = 0; c < n; ++c)
@@ -116,13 +125,12 @@ void bind_cut(py::module_& m) {
       "weights integrating Q_{m-1} exactly over the inside part (full square: total 1)");
   m.def(
       "insert_blocks",
-      [](dolfinx::la::SparsityPattern& pattern,
-         const py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>& dofs) {
-        if (dofs.ndim() != 2)
-          throw std::invalid_argument("dofs: expected an array of shape (n, k)");
+      [](dolfinx::la::SparsityPattern& pattern, const py::object& dofs_in) {
+        const contact::python::Indices dofs(Arg{"insert_blocks", "dofs"}, dofs_in, {any, any});
+        dofs.check_range(0, contact::python::pattern_blocks(pattern));
         const std::size_t k = dofs.shape(1);
         for (py::ssize_t r = 0; r < dofs.shape(0); ++r) {
-          std::span<const std::int32_t> d(dofs.data() + r * k, k);
+          std::span<const std::int32_t> d(dofs.flat().data() + r * k, k);
           pattern.insert(d, d);
         }
       },

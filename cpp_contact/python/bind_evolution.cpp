@@ -7,38 +7,35 @@
 
 namespace py = pybind11;
 using namespace contact;
-using contact::python::as_span;
-using contact::python::carray;
+using contact::python::any;
+using contact::python::Arg;
+using contact::python::fail;
+using contact::python::flat;
+using contact::python::input;
 using contact::python::to_numpy;
-
-namespace {
-using i8array = py::array_t<std::int8_t, py::array::c_style | py::array::forcecast>;
-} // namespace
 
 void bind_evolution(py::module_& m) {
   m.def(
       "extend_normal",
-      [](const StructuredGrid& grid, const carray& phi, const py::array& known_in,
-         const carray& values, int max_sweeps, bool full_output) -> py::object {
+      [](const StructuredGrid& grid, const py::object& phi_in, const py::object& known_in,
+         const py::object& values_in, int max_sweeps, bool full_output) -> py::object {
+        const char* f = "extend_normal";
         const auto n = py::ssize_t(grid.num_nodes());
+        const auto phi = input<double>(Arg{f, "phi"}, phi_in);
         if (phi.size() != n)
-          throw std::invalid_argument("extend_normal: phi must have one value per node (" +
-                                      std::to_string(n) + "), got " + std::to_string(phi.size()));
-        const i8array known = i8array::ensure(known_in);
-        if (!known or known.size() != n)
-          throw std::invalid_argument("extend_normal: known must be a bool/int8 array with one "
-                                      "flag per node (" +
-                                      std::to_string(n) + ")");
+          fail(Arg{f, "phi"}, "expected one value per node (" + std::to_string(n) + "), got " +
+                                  std::to_string(phi.size()));
+        const auto known = contact::python::flags(Arg{f, "known"}, known_in, std::size_t(n));
+        const auto values = input<double>(Arg{f, "values"}, values_in);
         if (values.ndim() < 1 or values.ndim() > 2 or values.shape(0) != n or
             (values.ndim() == 2 and values.shape(1) < 1))
-          throw std::invalid_argument("extend_normal: values must have shape (nodes,) or "
-                                      "(nodes, m) with nodes = " +
-                                      std::to_string(n));
+          fail(Arg{f, "values"},
+               "expected shape (nodes,) or (nodes, m) with nodes = " + std::to_string(n) +
+                   ", got " + contact::python::shape_str(values));
         const py::ssize_t mf = values.ndim() == 2 ? values.shape(1) : 1;
         std::vector<double> out(values.data(), values.data() + values.size());
-        const ExtensionInfo info = extend_normal(
-            grid, as_span(phi, "phi"), std::span<const std::int8_t>(known.data(), std::size_t(n)),
-            out, std::size_t(mf), max_sweeps);
+        const ExtensionInfo info =
+            extend_normal(grid, flat(phi), known.flat, out, std::size_t(mf), max_sweeps);
         std::vector<py::ssize_t> shape = {n};
         if (values.ndim() == 2)
           shape.push_back(mf);
@@ -59,9 +56,10 @@ void bind_evolution(py::module_& m) {
 
   m.def(
       "advect_levelset",
-      [](const LevelSet& phi, const carray& velocity, double time, double cfl) {
-        AdvectResult r =
-            advect(phi.grid(), phi.values(), as_span(velocity, "velocity", 2), time, cfl);
+      [](const LevelSet& phi, const py::object& velocity, double time, double cfl) {
+        const auto v = input<double>(Arg{"advect_levelset", "velocity"}, velocity,
+                                     {py::ssize_t(phi.grid().num_nodes()), 2});
+        AdvectResult r = advect(phi.grid(), phi.values(), flat(v), time, cfl);
         py::dict d;
         d["substeps"] = r.substeps;
         d["levelset"] = LevelSet(phi.grid(), std::move(r.values));
@@ -73,12 +71,11 @@ void bind_evolution(py::module_& m) {
 
   m.def(
       "weno5_derivatives",
-      [](const carray& line, double h) {
-        if (line.ndim() != 1)
-          throw std::invalid_argument("weno5_derivatives: line must be a 1D array");
+      [](const py::object& line_in, double h) {
+        const auto line = input<double>(Arg{"weno5_derivatives", "line"}, line_in, {any});
         const auto n = std::size_t(line.size());
         std::vector<double> mi(n), pl(n);
-        weno5_derivatives(as_span(line, "line"), h, mi, pl);
+        weno5_derivatives(flat(line), h, mi, pl);
         const auto sn = py::ssize_t(n);
         return py::make_tuple(to_numpy(std::move(mi), {sn}), to_numpy(std::move(pl), {sn}));
       },

@@ -8,31 +8,41 @@ namespace py = pybind11;
 using contact::MLSOptions;
 using contact::MLSProjector;
 using contact::MLSResult;
-using contact::python::as_span;
-using contact::python::carray;
+using contact::python::any;
+using contact::python::Arg;
+using contact::python::fail;
+using contact::python::flat;
+using contact::python::input;
 using contact::python::to_numpy;
 
 namespace {
-MLSProjector make_projector(const carray& sources, double h, double rcond_min, double widen_factor,
-                            int max_widenings) {
+MLSProjector make_projector(const py::object& sources_in, double h, double rcond_min,
+                            double widen_factor, int max_widenings) {
+  const auto sources = input<double>(Arg{"MLSProjector", "sources"}, sources_in);
   if (sources.ndim() != 2 or (sources.shape(1) != 2 and sources.shape(1) != 3))
-    throw std::invalid_argument("sources: expected an array of shape (n, 2) or (n, 3)");
+    fail(Arg{"MLSProjector", "sources"},
+         "expected an array of shape (n, 2) or (n, 3), got " + contact::python::shape_str(sources));
   const int dim = int(sources.shape(1));
-  return MLSProjector(as_span(sources, "sources", dim), dim, h,
-                      MLSOptions{rcond_min, widen_factor, max_widenings});
+  return MLSProjector(flat(sources), dim, h, MLSOptions{rcond_min, widen_factor, max_widenings});
 }
 
-py::dict project(const MLSProjector& mls, const carray& values, const carray& targets) {
+py::dict project(const MLSProjector& mls, const py::object& values_in,
+                 const py::object& targets_in) {
+  const char* f = "MLSProjector.project";
   const auto n = py::ssize_t(mls.num_points());
+  const auto values = input<double>(Arg{f, "values"}, values_in);
   if ((values.ndim() != 1 and values.ndim() != 2) or values.shape(0) != n)
-    throw std::invalid_argument("values: expected an array of shape (" + std::to_string(n) +
-                                ",) or (" + std::to_string(n) + ", m)");
+    fail(Arg{f, "values"}, "expected an array of shape (" + std::to_string(n) + ",) or (" +
+                               std::to_string(n) + ", m), got " +
+                               contact::python::shape_str(values));
   const std::size_t m = values.ndim() == 2 ? std::size_t(values.shape(1)) : 1;
-  const auto x = as_span(targets, "targets", mls.dim());
+  const auto targets = input<double>(Arg{f, "targets"}, targets_in, {any, mls.dim()});
+  const auto x = flat(targets);
+  const auto v = flat(values);
   MLSResult r;
   {
     py::gil_scoped_release release;
-    r = mls.project(std::span<const double>(values.data(), std::size_t(values.size())), m, x);
+    r = mls.project(v, m, x);
   }
   const auto k = py::ssize_t(r.widening.size());
   py::dict d;
@@ -50,7 +60,8 @@ py::dict project(const MLSProjector& mls, const carray& values, const carray& ta
 void bind_mls(py::module_& m) {
   m.def(
       "quadratic_spline_weight",
-      [](const carray& r) {
+      [](const py::object& r_in) {
+        const auto r = input<double>(Arg{"quadratic_spline_weight", "r"}, r_in);
         py::array_t<double> w(std::vector<py::ssize_t>(r.shape(), r.shape() + r.ndim()));
         const double* in = r.data();
         double* out = w.mutable_data();
