@@ -9,7 +9,6 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <span>
-#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -243,18 +242,6 @@ inline Flags flags(const Arg& arg, const py::handle& h, std::size_t size) {
                   " (shape " + shape_str(a) + ")");
   const auto* p = static_cast<const std::int8_t*>(a.data());
   return {a, std::span<const std::int8_t>(p, size)};
-}
-
-/// @brief Float64 array that numpy casts and copies as needed (forcecast): the unchecked form
-/// the bindings used before array.h's checked helpers; removed once none uses it.
-using carray = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-/// @brief View of a C-contiguous float64 array with a check on its trailing dimension.
-inline std::span<const double> as_span(const carray& a, const char* name, py::ssize_t cols = 0) {
-  if (cols > 0 and (a.ndim() != 2 or a.shape(1) != cols))
-    throw std::invalid_argument(std::string(name) + ": expected an array of shape (n, " +
-                                std::to_string(cols) + ")");
-  return std::span<const double>(a.data(), std::size_t(a.size()));
 }
 
 /// @brief Move a std::vector into a numpy array of the given shape (no copy).
