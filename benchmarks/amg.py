@@ -40,6 +40,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -72,7 +73,7 @@ SETUPS = {"tuned": None, "petsc": PETSC_GAMG, "hypre": HYPRE}
 # --------------------------------------------------------------------------- hertz
 def hertz_child(path, divisor, solver, npy):
     """One Hertz run in this process; prints a JSON record, saves u to npy."""
-    from dolfinx_forms.app.demo import compute
+    from dolfinx_forms.app.demo import Run
 
     hertz = hertz_demo()
     kinds = {"direct": ["condensed", "factorised"], "hypre": ["iterative"]}.get(solver, [solver])
@@ -81,10 +82,9 @@ def hertz_child(path, divisor, solver, npy):
         p["h"] = hertz.estimate(p)[1] / divisor
         p["petsc"] = HYPRE if solver == "hypre" else {}
         try:
-            run = compute(
-                "hertz", p, hertz.scene, hertz.problem, hertz.stages, hertz.evaluate,
-                reactions=["block_bottom"],
-            )  # fmt: skip
+            run = Run("hertz", p, plot=False)
+            hertz.solve(run, SimpleNamespace(**p))
+            run.close()
             break
         except ValueError as e:  # condensed does not apply: a full factorisation
             if "does not apply" not in str(e):
@@ -221,7 +221,7 @@ def bodies_table(divisors, gradings=(None, 1.2)):
     from dolfinx import la
     from petsc4py import PETSc
 
-    from dolfinx_forms.app.demo import compute
+    from dolfinx_forms.app.demo import Run
     from dolfinx_forms.solvers import linear
 
     hertz = hertz_demo()
@@ -232,7 +232,9 @@ def bodies_table(divisors, gradings=(None, 1.2)):
             argv += [] if grading is None else ["--grading", str(grading)]
             p = vars(hertz.parse(argv))
             p["h"] = hertz.estimate(p)[1] / d
-            pb = compute("hertz", p, hertz.scene, hertz.problem, hertz.stages).problem
+            run = Run("hertz", p, plot=False)
+            hertz.solve(run, SimpleNamespace(**p))
+            pb = run.problem
             pb.residual(pb.lam, with_tangent=True)
             A = pb.J.copy()
             A.zeroRowsColumns(pb.bc_global, diag=1.0)

@@ -26,6 +26,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 from benchmarks.common import child, hertz_demo, write_atomic, write_text
 
@@ -100,8 +101,7 @@ def _reference_timed(discretization, divisor, timer):
     hertz = hertz_demo()
     p = vars(hertz.parse(["--discretization", discretization]))
     p["h"] = hertz.estimate(p)[1] / divisor
-    run = type("Run", (), {"params": p, "comm": MPI.COMM_WORLD})()
-    sc = hertz.scene(run)
+    sc = hertz.scene(MPI.COMM_WORLD, SimpleNamespace(**p))
     bcs = [Dirichlet("block_bottom", None, 0.0), Dirichlet("cylinder_top", None, -0.01)]
     laws = {b.tag: (p["E"], p["nu"]) for b in sc.bodies}
     pb = ContactProblem(sc, laws, dirichlet=bcs, timer=timer, linear_solver="factorised")

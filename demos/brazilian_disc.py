@@ -22,7 +22,8 @@ import sys
 import numpy as np
 
 from dolfinx_forms.app import cli
-from dolfinx_forms.app.mpm_run import binned_mean, run_steps
+from dolfinx_forms.app.demo import Run
+from dolfinx_forms.app.mpm_run import Steps, binned_mean
 from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
 from meshes.mpm import brazilian_disc
@@ -81,40 +82,6 @@ def parse(argv):
 def hertz_half_width(F, R, E, nu):
     """Cylinder on a rigid flat (plane strain): a = 2 sqrt(F R (1 - nu^2) / (pi E))."""
     return 2 * np.sqrt(np.maximum(F, 0) * R * (1 - nu**2) / (np.pi * E))
-
-
-def build(run):
-    p = run.params
-    grid, (name, tag, shape), platens, scene = brazilian_disc(
-        run.comm, p["R"], p["h"], p["step_displacement"], p["steps"]
-    )
-    symmetry = Dirichlet(lambda x: np.isclose(x[0], 0.0, atol=1e-9 * p["R"]), 0, 0.0)
-    return ImplicitMPM(
-        run.comm,
-        grid,
-        [MPMBody(name, tag, (p["E"], p["nu"]), shape)],
-        scene,
-        obstacles=platens,
-        dirichlet=[symmetry],
-        timer=run.timer,
-        **run.problem_options,  # mu, eps0, --petsc, --linear-solver
-    )
-
-
-def row(run, rec):
-    widths = {q["body_j"]: q["half_width"] for q in rec["pairs"]}
-    return dict(
-        step=rec["step"],
-        displacement=rec["step"] * run.params["step_displacement"],
-        force_top=rec["obstacles"]["platen_top"]["fy"],
-        force_bottom=-rec["obstacles"]["platen_bottom"]["fy"],
-        half_width_top=widths.get("platen_top", 0.0),
-        half_width_bottom=widths.get("platen_bottom", 0.0),
-        area_levelset=rec["area_levelset"]["disc"],
-        volume_points=rec["volume_points"]["disc"],
-        newton_iterations=rec["newton_iterations"],
-        wall_s=rec["wall_s"],
-    )
 
 
 def evaluate(run):
@@ -206,19 +173,52 @@ def summary(run):
 
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
-    params = vars(args)
-    return run_steps(
-        "brazilian",
-        params,
-        build,
-        args.steps,
-        row,
-        COLUMNS,
-        evaluate=evaluate,
-        plots=plots,
-        summary=summary,
-        series_every=args.series_every,
-    )
+    with Run("brazilian", vars(args), discretization="cut", plot=False) as run:
+        # the scene: the disc's level set and material points, the two rigid platens, moving
+        grid, (name, tag, shape), platens, scene = brazilian_disc(
+            run.comm, args.R, args.h, args.step_displacement, args.steps
+        )
+        # the problem: the disc (plane strain, linear elastic) between the platens, x = 0 held
+        # horizontally (the symmetry line)
+        symmetry = Dirichlet(lambda x: np.isclose(x[0], 0.0, atol=1e-9 * args.R), 0, 0.0)
+        sim = ImplicitMPM(
+            run.comm,
+            grid,
+            [MPMBody(name, tag, (args.E, args.nu), shape)],
+            scene,
+            obstacles=platens,
+            dirichlet=[symmetry],
+            timer=run.timer,
+            **run.problem_options,  # mu, eps0, --petsc, --linear-solver
+        )
+
+        # the run: the platens close by step_displacement per step
+        steps = Steps(run, sim, COLUMNS, args.steps, args.series_every)
+        for _ in range(args.steps):
+            rec = steps.step()
+            widths = {q["body_j"]: q["half_width"] for q in rec["pairs"]}
+            steps.rows.append(
+                dict(
+                    step=rec["step"],
+                    displacement=rec["step"] * args.step_displacement,
+                    force_top=rec["obstacles"]["platen_top"]["fy"],
+                    force_bottom=-rec["obstacles"]["platen_bottom"]["fy"],
+                    half_width_top=widths.get("platen_top", 0.0),
+                    half_width_bottom=widths.get("platen_bottom", 0.0),
+                    area_levelset=rec["area_levelset"]["disc"],
+                    volume_points=rec["volume_points"]["disc"],
+                    newton_iterations=rec["newton_iterations"],
+                    wall_s=rec["wall_s"],
+                )
+            )
+        steps.measure()
+
+        # the check: Hertz's half-width where a > 5 h, force balance, area against the
+        # points' volume, mass (rank 0)
+        if run.rank0:
+            evaluate(run)
+        run.finish(summary, **steps.outputs(plots))
+    return run.status
 
 
 if __name__ == "__main__":

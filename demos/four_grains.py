@@ -24,7 +24,8 @@ import sys
 import numpy as np
 
 from dolfinx_forms.app import cli
-from dolfinx_forms.app.mpm_run import binned_mean, plot_force_chains, run_steps
+from dolfinx_forms.app.demo import Run
+from dolfinx_forms.app.mpm_run import Steps, binned_mean, plot_force_chains
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody, equilibrium_error
 from meshes.four_grains import check_contact_zones, four_grains, grain_outlines
 from meshes.mpm import plate_face_conditions
@@ -80,49 +81,8 @@ def parse(argv):
     return a
 
 
-def build(run):
-    p = run.params
-    grid, bodies, scene, faces = four_grains(
-        run.comm,
-        h=p["h"],
-        radius=p["radius"],
-        seed=p["seed"],
-        overlap=p["overlap"],
-        clearance=CLEARANCE,
-        outlines=run.data["outlines"],
-    )
-    run.data["faces"] = faces
-    bcs = plate_face_conditions(faces, p["displacement"])
-    return ImplicitMPM(
-        run.comm,
-        grid,
-        [MPMBody(n, t, (p["E"], p["nu"]), s) for n, t, s in bodies],
-        scene,
-        dirichlet=bcs,
-        timer=run.timer,
-        **run.problem_options,  # mu, eps0, --petsc, --linear-solver
-    )
-
-
 def active(rec):
     return [q for q in rec["pairs"] if q["normal_force"] > 0]
-
-
-def row(run, rec):
-    f = rec["body_forces"]
-    act = active(rec)
-    return dict(
-        step=rec["step"],
-        displacement=rec["step"] * run.params["displacement"],
-        force_left=-f["plate_left"][0],
-        force_right=f["plate_right"][0],
-        force_bottom=-f["plate_bottom"][1],
-        force_top=f["plate_top"][1],
-        active_contacts=len(act),
-        min_stick_fraction=min(q["stick_fraction"] for q in act),
-        newton_iterations=rec["newton_iterations"],
-        wall_s=rec["wall_s"],
-    )
 
 
 def evaluate(run):
@@ -203,23 +163,56 @@ def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
     params = vars(args)
     outlines = params.pop("outlines")
-
-    def build_with(run):
+    with Run("four_grains", params, discretization="cut", plot=False) as run:
+        # the scene: four Fourier grains in a box of four plates, level sets with points
         run.data["outlines"] = outlines
-        return build(run)
+        grid, bodies, scene, faces = four_grains(
+            run.comm,
+            h=args.h,
+            radius=args.radius,
+            seed=args.seed,
+            overlap=args.overlap,
+            clearance=CLEARANCE,
+            outlines=outlines,
+        )
+        run.data["faces"] = faces
+        # the problem: the plates' outer faces moved inward by `displacement` per step
+        sim = ImplicitMPM(
+            run.comm,
+            grid,
+            [MPMBody(n, t, (args.E, args.nu), s) for n, t, s in bodies],
+            scene,
+            dirichlet=plate_face_conditions(faces, args.displacement),
+            timer=run.timer,
+            **run.problem_options,  # mu, eps0, --petsc, --linear-solver
+        )
 
-    return run_steps(
-        "four_grains",
-        params,
-        build_with,
-        args.steps,
-        row,
-        COLUMNS,
-        evaluate=evaluate,
-        plots=plots,
-        summary=summary,
-        series_every=1,
-    )
+        # the run
+        steps = Steps(run, sim, COLUMNS, args.steps, series_every=1)
+        for _ in range(args.steps):
+            rec = steps.step()
+            f, act = rec["body_forces"], active(rec)
+            steps.rows.append(
+                dict(
+                    step=rec["step"],
+                    displacement=rec["step"] * args.displacement,
+                    force_left=-f["plate_left"][0],
+                    force_right=f["plate_right"][0],
+                    force_bottom=-f["plate_bottom"][1],
+                    force_top=f["plate_top"][1],
+                    active_contacts=len(act),
+                    min_stick_fraction=min(q["stick_fraction"] for q in act),
+                    newton_iterations=rec["newton_iterations"],
+                    wall_s=rec["wall_s"],
+                )
+            )
+        steps.measure()
+
+        # the check (rank 0)
+        if run.rank0:
+            evaluate(run)
+        run.finish(summary, **steps.outputs(plots))
+    return run.status
 
 
 if __name__ == "__main__":

@@ -23,7 +23,8 @@ import sys
 import numpy as np
 
 from dolfinx_forms.app import cli
-from dolfinx_forms.app.mpm_run import plot_force_chains, run_steps
+from dolfinx_forms.app.demo import Run
+from dolfinx_forms.app.mpm_run import Steps, plot_force_chains
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody, equilibrium_error
 from meshes.assembly import grain_assembly
 
@@ -68,35 +69,11 @@ def parse(argv):
     return a
 
 
-def build(run):
-    p = run.params
-    grid, bodies, plates, scene, box, _ = grain_assembly(
-        run.comm, p["grains"], p["radius"], p["h"], aspect=1.1, overlap=0.02 * p["h"]
-    )
-    d = p["compression"]
-    for name, t in zip(PLATES, ((d, 0), (-d, 0), (0, d), (0, -d))):
-        plates[name].translation = np.array(t, float)
-    run.data.update(plates=plates, height=box[1, 1] - box[0, 1])
-    return ImplicitMPM(
-        run.comm,
-        grid,
-        [MPMBody(n, t, (p["E"], p["nu"]), s) for n, t, s in bodies],
-        scene,
-        obstacles=list(plates.values()),
-        mu=np.tan(np.radians(p["friction_angle"])),
-        predictor_gap=0.5 * p["h"],
-        timer=run.timer,
-        **run.problem_options,  # eps0, --petsc, --linear-solver
-    )
-
-
-def row(run, rec):
-    """Plate forces in each plate's frame (normal: compression positive) after the step; at the
-    end of the compression the lateral plates start turning (simple shear)."""
-    p, plates = run.params, run.data["plates"]
+def plate_row(rec, plates, phase):
+    """The steps.csv row: plate forces in each plate's frame (normal: compression positive)."""
     out = dict(
         step=rec["step"],
-        phase="compression" if rec["step"] <= p["steps"] else "shear",
+        phase=phase,
         newton_iterations=rec["newton_iterations"],
         wall_s=rec["wall_s"],
     )
@@ -112,12 +89,6 @@ def row(run, rec):
         f = np.array([rec["obstacles"][name]["fx"], rec["obstacles"][name]["fy"]])
         out[f"{name}_normal"] = float(-f @ m)
         out[f"{name}_tangential"] = float(f @ np.array([-m[1], m[0]]))
-    if rec["step"] == p["steps"]:  # compression done: turn the lateral plates from now on
-        run.data["end_of_compression"] = rec
-        for name in PLATES:
-            plates[name].translation = np.zeros(2)
-        for name in ("plate_left", "plate_right"):
-            plates[name].rotation = -p["shear_rotation"]
     return out
 
 
@@ -172,17 +143,47 @@ def summary(run):
 
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
-    return run_steps(
-        "grain_assembly",
-        vars(args),
-        build,
-        args.steps + args.shear_steps,
-        row,
-        COLUMNS,
-        evaluate=evaluate,
-        plots=plots,
-        summary=summary,
-    )
+    with Run("grain_assembly", vars(args), discretization="cut", plot=False) as run:
+        # the scene: a hexagonal packing of elliptic grains between four rigid plates
+        grid, bodies, plates, scene, box, _ = grain_assembly(
+            run.comm, args.grains, args.radius, args.h, aspect=1.1, overlap=0.02 * args.h
+        )
+        d = args.compression  # the plates' inward travel per compression step
+        for name, t in zip(PLATES, ((d, 0), (-d, 0), (0, d), (0, -d))):
+            plates[name].translation = np.array(t, float)
+        run.data.update(plates=plates, height=box[1, 1] - box[0, 1])
+        # the problem: Coulomb friction at the friction angle, on grains and plates alike
+        sim = ImplicitMPM(
+            run.comm,
+            grid,
+            [MPMBody(n, t, (args.E, args.nu), s) for n, t, s in bodies],
+            scene,
+            obstacles=list(plates.values()),
+            mu=np.tan(np.radians(args.friction_angle)),
+            predictor_gap=0.5 * args.h,
+            timer=run.timer,
+            **run.problem_options,  # eps0, --petsc, --linear-solver
+        )
+
+        # the run: compression by the four plates, then simple shear (the lateral plates turn)
+        steps = Steps(run, sim, COLUMNS, args.steps + args.shear_steps)
+        for _ in range(args.steps + args.shear_steps):
+            rec = steps.step()
+            phase = "compression" if rec["step"] <= args.steps else "shear"
+            steps.rows.append(plate_row(rec, plates, phase))
+            if rec["step"] == args.steps:  # compression done: turn the lateral plates from now on
+                run.data["end_of_compression"] = rec
+                for name in PLATES:
+                    plates[name].translation = np.zeros(2)
+                for name in ("plate_left", "plate_right"):
+                    plates[name].rotation = -args.shear_rotation
+        steps.measure()
+
+        # the check (rank 0)
+        if run.rank0:
+            evaluate(run)
+        run.finish(summary, **steps.outputs(plots))
+    return run.status
 
 
 if __name__ == "__main__":

@@ -141,49 +141,58 @@ SUMMARY = (
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
     args.protocol = PROTOCOL
-    p, cut = vars(args), args.discretization == "cut"
-    E_star, a = estimate(p)
-    with Run("mindlin" if args.tangential else "hertz", p) as run:
-        # the scene: the block and the half-cylinder, mesh size h on |x|, |y| < zone a
-        size = dict(R=args.R, width=args.width, depth=args.depth, h=args.h, zone=args.zone * a)
-        size["band"] = band(p)  # rank 0 holds the cells of Gamma_c
-        # the far field coarsens with h, so that its error falls with h's (fixed h_far: a floor)
-        size["h_far"] = args.h_far or min(args.R / 2, args.depth / 2, 100 * args.h)
-        # body-fitted slope 0.5 instead: the same error at a/20 but a floor of 0.55 % from a/40
-        size["growth"] = args.grading or (2.0 if cut else 0.25)
-        with run.phase("mesh"):
-            if cut:  # graded grid, spacing h on the zone; cylinder cut
-                run.scene = hertz_cut_scene(run.comm, **size)
-            else:
-                run.scene = hertz_scene(run.comm, **size, quads=args.quads, mesher=args.mesher)
-
-        # the problem: block clamped at its bottom, the cylinder top held (moved by the stages)
-        top_x, top_y = Dirichlet("cylinder_top", 0, 0.0), Dirichlet("cylinder_top", 1, 0.0)
-        bcs = [Dirichlet("block_bottom", None, 0.0), top_x, top_y]
-        pb = run.problem = run.contact_problem(bcs, mu=0.0, band=band(p))
-
-        # the run: the top pressed down until the reaction is P (frictionless; the approach
-        # solved for in Newton with the equation "reaction = P"), from the rigid interference
-        # a^2 / 2R, whose overlap |x| < a is Hertz's contact (3-4 iterations; a^2 / R: 9-10).
-        # Then friction on and the top moved sideways while the tangential reaction rises to
-        # Q = r mu P (monotonic loading, as Cattaneo-Mindlin assumes).
-        P, r = args.load, args.tangential
-        guess = -(a**2) / (2 * args.R)
-        run.records = [reach_force(pb, top_y, "block_bottom", 1, P, guess, steps=args.steps)]
-        if r > 0:
-            run.records.append(friction_on(pb, args.mu))
-            Q, probe = r * args.mu * P, 1e-3 * run.scene.h_contact  # the full-stick stiffness
-            n = args.tangential_steps
-            tangential = reach_force(pb, top_x, "cylinder_top", 0, Q, probe, 2e-3, n, monotone=True)
-            run.records.append(tangential)
-        run.measure(reactions=["block_bottom", "cylinder_top"])
-
-        # the check: a, p0, p(x) (and the stick zone) against Hertz (and Cattaneo-Mindlin) at
-        # the computed loads (rank 0)
-        if run.rank0:
-            evaluate(run, E_star)
+    with Run("mindlin" if args.tangential else "hertz", vars(args)) as run:
+        solve(run, args)
         run.finish(SUMMARY)
     return run.status
+
+
+def scene(comm, args):
+    """The block and the half-cylinder, mesh size h on |x|, |y| < zone a."""
+    cut, a = args.discretization == "cut", estimate(vars(args))[1]
+    size = dict(R=args.R, width=args.width, depth=args.depth, h=args.h, zone=args.zone * a)
+    size["band"] = band(vars(args))  # rank 0 holds the cells of Gamma_c
+    # the far field coarsens with h, so that its error falls with h's (fixed h_far: a floor)
+    size["h_far"] = args.h_far or min(args.R / 2, args.depth / 2, 100 * args.h)
+    # body-fitted slope 0.5 instead: the same error at a/20 but a floor of 0.55 % from a/40
+    size["growth"] = args.grading or (2.0 if cut else 0.25)
+    if cut:  # graded grid, spacing h on the zone; cylinder cut
+        return hertz_cut_scene(comm, **size)
+    return hertz_scene(comm, **size, quads=args.quads, mesher=args.mesher)
+
+
+def solve(run, args):
+    """Scene, problem, loading and check of one run (main; the benchmarks call it too)."""
+    p = vars(args)
+    E_star, a = estimate(p)
+    with run.phase("mesh"):
+        run.scene = scene(run.comm, args)
+
+    # the problem: block clamped at its bottom, the cylinder top held (moved by the stages)
+    top_x, top_y = Dirichlet("cylinder_top", 0, 0.0), Dirichlet("cylinder_top", 1, 0.0)
+    bcs = [Dirichlet("block_bottom", None, 0.0), top_x, top_y]
+    pb = run.problem = run.contact_problem(bcs, mu=0.0, band=band(p))
+
+    # the run: the top pressed down until the reaction is P (frictionless; the approach
+    # solved for in Newton with the equation "reaction = P"), from the rigid interference
+    # a^2 / 2R, whose overlap |x| < a is Hertz's contact (3-4 iterations; a^2 / R: 9-10).
+    # Then friction on and the top moved sideways while the tangential reaction rises to
+    # Q = r mu P (monotonic loading, as Cattaneo-Mindlin assumes).
+    P, r = args.load, args.tangential
+    guess = -(a**2) / (2 * args.R)
+    run.records = [reach_force(pb, top_y, "block_bottom", 1, P, guess, steps=args.steps)]
+    if r > 0:
+        run.records.append(friction_on(pb, args.mu))
+        Q, probe = r * args.mu * P, 1e-3 * run.scene.h_contact  # the full-stick stiffness
+        n = args.tangential_steps
+        tangential = reach_force(pb, top_x, "cylinder_top", 0, Q, probe, 2e-3, n, monotone=True)
+        run.records.append(tangential)
+    run.measure(reactions=["block_bottom", "cylinder_top"])
+
+    # the check: a, p0, p(x) (and the stick zone) against Hertz (and Cattaneo-Mindlin) at
+    # the computed loads (rank 0)
+    if run.rank0:
+        evaluate(run, E_star)
 
 
 if __name__ == "__main__":

@@ -23,7 +23,8 @@ import sys
 import numpy as np
 
 from dolfinx_forms.app import cli
-from dolfinx_forms.app.mpm_run import plot_force_chains, run_steps
+from dolfinx_forms.app.demo import Run
+from dolfinx_forms.app.mpm_run import Steps, plot_force_chains
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody, equilibrium_error
 from meshes.mpm import nine_discs, plate_face_conditions
 
@@ -75,36 +76,6 @@ def parse(argv):
     if not a.steps * a.displacement <= 0.1 * a.R:
         p.error(f"--displacement: steps x displacement must be <= 0.1 R = {0.1 * a.R:g}")
     return a
-
-
-def build(run):
-    p = run.params
-    grid, bodies, scene, faces = nine_discs(run.comm, R=p["R"], h=p["h"], overlap=p["overlap"])
-    run.data["faces"] = faces
-    bcs = plate_face_conditions(faces, p["displacement"])
-    return ImplicitMPM(
-        run.comm,
-        grid,
-        [MPMBody(n, t, (p["E"], p["nu"]), s) for n, t, s in bodies],
-        scene,
-        dirichlet=bcs,
-        timer=run.timer,
-        **run.problem_options,  # mu, eps0, --petsc, --linear-solver
-    )
-
-
-def row(run, rec):
-    f = rec["body_forces"]
-    return dict(
-        step=rec["step"],
-        displacement=rec["step"] * run.params["displacement"],
-        force_left=-f["plate_left"][0],
-        force_right=f["plate_right"][0],
-        force_bottom=-f["plate_bottom"][1],
-        force_top=f["plate_top"][1],
-        newton_iterations=rec["newton_iterations"],
-        wall_s=rec["wall_s"],
-    )
 
 
 def symmetry_error(sim, rec, h):
@@ -183,18 +154,45 @@ def summary(run):
 
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
-    return run_steps(
-        "nine_discs",
-        vars(args),
-        build,
-        args.steps,
-        row,
-        COLUMNS,
-        evaluate=evaluate,
-        plots=plots,
-        summary=summary,
-        series_every=1,
-    )
+    with Run("nine_discs", vars(args), discretization="cut", plot=False) as run:
+        # the scene: 3 x 3 discs in a box of four plates, each a level-set body with points
+        grid, bodies, scene, faces = nine_discs(run.comm, R=args.R, h=args.h, overlap=args.overlap)
+        run.data["faces"] = faces
+        # the problem: the plates' outer faces moved inward by `displacement` per step
+        sim = ImplicitMPM(
+            run.comm,
+            grid,
+            [MPMBody(n, t, (args.E, args.nu), s) for n, t, s in bodies],
+            scene,
+            dirichlet=plate_face_conditions(faces, args.displacement),
+            timer=run.timer,
+            **run.problem_options,  # mu, eps0, --petsc, --linear-solver
+        )
+
+        # the run
+        steps = Steps(run, sim, COLUMNS, args.steps, series_every=1)
+        for _ in range(args.steps):
+            rec = steps.step()
+            f = rec["body_forces"]
+            steps.rows.append(
+                dict(
+                    step=rec["step"],
+                    displacement=rec["step"] * args.displacement,
+                    force_left=-f["plate_left"][0],
+                    force_right=f["plate_right"][0],
+                    force_bottom=-f["plate_bottom"][1],
+                    force_top=f["plate_top"][1],
+                    newton_iterations=rec["newton_iterations"],
+                    wall_s=rec["wall_s"],
+                )
+            )
+        steps.measure()
+
+        # the check: D4 symmetry of forces and stresses, every body in equilibrium (rank 0)
+        if run.rank0:
+            evaluate(run)
+        run.finish(summary, **steps.outputs(plots))
+    return run.status
 
 
 if __name__ == "__main__":

@@ -225,3 +225,11 @@ def test_demo_refuses_foreign_out_before_computing(tmp_path):
     assert (out / "data.txt").read_text() == "keep"
     assert json.loads((out / "metrics.json").read_text())["benchmark"] == "patch"
     assert read_marker(out)["program"] == "patch_test.py"
+
+
+def test_too_long_a_folder_name_is_refused_before_computing(tmp_path):
+    """A name the file system cannot hold (with the temporary folder's affixes) is one line
+    at parse time, not a traceback after the run (issue 29)."""
+    with pytest.raises(OutputFolderError, match="a folder name of at most"):
+        check_output_path(tmp_path / ("a" * 300))
+    assert check_output_path(tmp_path / ("a" * 200)) == (tmp_path / ("a" * 200)).resolve()

@@ -149,7 +149,7 @@ def test_plot_worker_started_early_for_a_demo(monkeypatch, tmp_path):
     main.__file__ = str(ROOT / "demos" / "hertz.py")
     plot_worker.start_early()
     assert started == [1]
-    output.start_plot_worker()  # run_case: takes the early worker, starts no other
+    output.start_plot_worker()  # demo.Run: takes the early worker, starts no other
     assert output._worker == "worker" and started == [1] and plot_worker.take_early() is None
     output._worker = None
 

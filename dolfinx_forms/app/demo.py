@@ -69,7 +69,9 @@ class Run:
         self.scene = None
         self.problem = None  # None: no solver (a geometry demo)
         self.loads = {}  # named loads
-        self.records = []  # the stages' StageRecords (protocol.py)
+        self.records = []  # the stages' StageRecords (protocol.py), or the steps' records
+        self.sim = None  # a multi-step run's ImplicitMPM (mpm_run.Steps)
+        self.rows = []  # a multi-step run's steps.csv rows (mpm_run.Steps)
         self.reactions = {}  # {boundary: [Fx, Fy(, Fz)]}, every rank
         self.pts = None  # the contact points (output.gather_points), rank 0 only
         self.data = {}  # the demo's own values
@@ -112,6 +114,12 @@ class Run:
     @property
     def rank0(self):
         return self.comm.rank == 0
+
+    @property
+    def problem_options(self):
+        """The ContactProblem keywords its parameters name (mu, eps0, --petsc,
+        --linear-solver, ...), for `ContactProblem` and `ImplicitMPM` alike."""
+        return problem_options(self.params)
 
     def phase(self, name):
         """Time a block as one of the phases of metrics.json (results.PHASES)."""

@@ -9,24 +9,17 @@ displacement since the start) and `levelsets.xdmf` (the background grid with eac
 set and extended step displacement). The series store raw little-endian float64 files beside the
 .xdmf (XDMF "Binary" items; no HDF5 needed), one frame every `series_every` steps.
 
-`run_steps` is the skeleton of a multi-step demo, as `demo.run_case` is for one load path:
-metrics record and phase timer -> build the simulation -> steps (a ContactSolverError or a
-RuntimeError of the step's geometry ends the run: one line on stderr, nothing written, exit
-status 1) -> evaluate (rank 0) -> one atomic
-folder -> summary and "results in ...".
+`Steps` is the step loop of a multi-step demo inside the run skeleton every demo uses
+(`demo.Run`): records, warnings, series frames, the metrics blocks and the step files.
 """
 
 from __future__ import annotations
 
 import csv
-import sys
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from dolfinx_forms.app.demo import problem_options
-from dolfinx_forms.io.results import PhaseTimer, new_metrics
 from dolfinx_forms.solvers.newton import ContactSolverError
 
 CONTACT_COLUMNS = [
@@ -134,144 +127,112 @@ def add_frames(sim, points_series, grid_series, step, x0):
     grid_series.add(step, np.stack([X.ravel(), Y.ravel()], axis=1), data, quads)
 
 
-@dataclass
-class StepRun:
-    """State of a multi-step run handed to the callbacks of `run_steps`."""
+class Steps:
+    """The step loop of a multi-step demo inside its `demo.Run` block:
 
-    name: str
-    comm: object
-    metrics: dict
-    timer: PhaseTimer
-    sim: object = None
-    records: list = field(default_factory=list)  # ImplicitMPM.step records
-    rows: list = field(default_factory=list)  # steps.csv rows
-    data: dict = field(default_factory=dict)
+        with Run("brazilian", params, discretization="cut", plot=False) as run:
+            sim = ImplicitMPM(...)
+            steps = Steps(run, sim, COLUMNS, args.steps, args.series_every)
+            for _ in range(args.steps):
+                rec = steps.step()
+                steps.rows.append({...the demo's steps.csv row...})
+            steps.measure()
+            if run.rank0:
+                ...the check...
+            run.finish(summary, **steps.outputs(plots))
 
-    @property
-    def params(self):
-        return self.metrics["parameters"]
+    `step` runs one ImplicitMPM step, keeps its record, the self-checks' warnings (with the
+    first step that saw each) and the series frames (the first step, every `series_every`-th,
+    the last). A ContactSolverError or a RuntimeError of the step's geometry becomes a
+    ContactSolverError "step k: ..." (the Run ends with one line and status 1). `measure`
+    fills the mesh and solver blocks of metrics.json; `outputs` gives `Run.finish` the files:
+    steps.csv, contacts.csv, bodies.csv, the series, then the demo's plots."""
 
-    @property
-    def results(self):
-        return self.metrics["results"]
+    def __init__(self, run, sim, columns, num_steps, series_every=10):
+        self.run, self.sim, self.columns = run, sim, columns
+        run.sim = sim
+        self.num_steps, self.series_every = num_steps, series_every
+        self.records = run.records = []  # ImplicitMPM.step records
+        self.rows = run.rows = []  # steps.csv rows
+        self.points_series, self.grid_series = {}, Series("levelsets")
+        run.data["series"] = self.points_series  # {body name: Series} of the points (rank 0)
+        self.checks = {}  # warning -> first step where it was seen
+        self._x0 = None
 
-    @property
-    def analytic(self):
-        return self.metrics["analytic"]
+    def step(self):
+        from dolfinx_forms.solvers.checks import contact_warnings
 
-    @property
-    def problem_options(self):
-        """The ContactProblem keywords its parameters name (`demo.problem_options`: mu, eps0,
-        --petsc, --linear-solver, ...), for `ImplicitMPM`."""
-        return problem_options(self.params)
+        k = len(self.records)
+        try:
+            rec = self.sim.step()
+        except (ContactSolverError, RuntimeError) as e:  # Newton, or the geometry of a step
+            raise ContactSolverError(f"step {k + 1}: {e}") from e
+        self.records.append(rec)
+        for w in contact_warnings(self.sim.problem):
+            self.checks.setdefault(w, rec["step"])
+        if self._x0 is None:  # positions at seeding: the first step's points before it moved
+            self._x0 = {
+                t: p.x - d for (t, p), d in zip(self.sim.points.items(), self.sim.first_step_du)
+            }
+        last = k + 1 == self.num_steps
+        if self.run.rank0 and ((k + 1) % self.series_every == 0 or last or k == 0):
+            add_frames(self.sim, self.points_series, self.grid_series, rec["step"], self._x0)
+        return rec
 
-
-def run_steps(
-    name,
-    params,
-    build,
-    num_steps,
-    row,
-    columns,
-    *,
-    evaluate=None,
-    plots=None,
-    summary=None,
-    series_every=10,
-    comm=None,
-    prog=None,
-):
-    """A multi-step demo (module docstring). build(run) -> ImplicitMPM (timed as "mesh" only
-    for what it does itself); row(run, record) -> the steps.csv row {column: value};
-    evaluate(run) on rank 0 fills results/analytic and solver warnings; plots(run, folder) on
-    rank 0. Returns the exit status."""
-    from mpi4py import MPI
-
-    from dolfinx_forms.io.folders import atomic_output_dir
-    from dolfinx_forms.io.results import write_metrics
-    from dolfinx_forms.solvers.checks import contact_warnings
-
-    comm = MPI.COMM_WORLD if comm is None else comm
-    prog = prog or Path(sys.argv[0]).name
-    metrics = new_metrics(name, "cut", params)
-    run = StepRun(name, comm, metrics, PhaseTimer(metrics))
-    points_series, grid_series = {}, Series("levelsets")
-    run.data["series"] = points_series  # {body name: Series} of the material points (rank 0)
-    checks = {}  # warning -> first step where it was seen
-    try:
-        run.sim = build(run)
-        x0 = None
-        for k in range(num_steps):
-            rec = run.sim.step()
-            run.records.append(rec)
-            for w in contact_warnings(run.sim.problem):
-                checks.setdefault(w, rec["step"])
-            run.rows.append(row(run, rec))
-            if x0 is None:  # positions at seeding: the first step's points before it moved
-                x0 = {
-                    t: p.x - d for (t, p), d in zip(run.sim.points.items(), run.sim.first_step_du)
-                }
-            if comm.rank == 0 and ((k + 1) % series_every == 0 or k + 1 == num_steps or k == 0):
-                add_frames(run.sim, points_series, grid_series, rec["step"], x0)
-    except (ContactSolverError, RuntimeError) as e:  # Newton, or the geometry of a step
-        if comm.rank == 0:
-            sys.stderr.write(f"{prog}: step {len(run.records) + 1}: {e}\n")
-        return 1
-    last = run.records[-1]
-    metrics["mesh"].update(
-        h_contact=run.sim.h, num_cells=last["num_cells"], num_dofs=last["num_dofs"]
-    )
-    metrics["solver"].update(
-        load_steps=len(run.records),
-        newton_iterations=[r["newton_iterations"] for r in run.records],
-        converged=True,
-        residual_history=[],
-        penalty={"eps_n": run.sim.problem.eps_n, "eps_t": run.sim.problem.eps_t},
-        linear_solver=run.sim.problem.linear.name,  # the last step's
-        condensed_dofs=int(getattr(run.sim.problem.linear, "num_dofs", 0)),
-        cutbacks=int(sum(r["cutbacks"] for r in run.records)),
-        warnings=[f"step {k}: {w}" for w, k in checks.items()],
-    )
-    if evaluate is not None and comm.rank == 0:
-        evaluate(run)
-    run.timer.stop()
-    run.metrics = metrics = comm.bcast(metrics if comm.rank == 0 else None, root=0)
-    contacts = [
-        dict(step=r["step"], **{c: p[c] for c in CONTACT_COLUMNS[1:]})
-        for r in run.records
-        for p in r["pairs"]
-    ]
-    bodies = [
-        dict(
-            step=r["step"],
-            body=b.name,
-            fx=r["body_forces"][b.name][0],
-            fy=r["body_forces"][b.name][1],
-            moment=r["body_forces"][b.name][2],
-            area_levelset=r["area_levelset"][b.name],
-            volume_points=r["volume_points"][b.name],
+    def measure(self):
+        """The mesh and solver blocks of metrics.json from the steps' records."""
+        sim, last, metrics = self.sim, self.records[-1], self.run.metrics
+        metrics["mesh"].update(
+            h_contact=sim.h, num_cells=last["num_cells"], num_dofs=last["num_dofs"]
         )
-        for r in run.records
-        for b in run.sim.bodies
-    ]
-    with atomic_output_dir(params["out"], comm, force=params.get("force", False)) as folder:
-        folder = Path(folder)
-        if comm.rank == 0:
-            write_csv(folder / "steps.csv", columns, run.rows)
-            write_csv(folder / "contacts.csv", CONTACT_COLUMNS, contacts)
-            write_csv(folder / "bodies.csv", BODY_COLUMNS, bodies)
-            for s in list(points_series.values()) + [grid_series]:
-                s.write(folder)
+        metrics["solver"].update(
+            load_steps=len(self.records),
+            newton_iterations=[r["newton_iterations"] for r in self.records],
+            converged=True,
+            residual_history=[],
+            penalty={"eps_n": sim.problem.eps_n, "eps_t": sim.problem.eps_t},
+            linear_solver=sim.problem.linear.name,  # the last step's
+            condensed_dofs=int(getattr(sim.problem.linear, "num_dofs", 0)),
+            cutbacks=int(sum(r["cutbacks"] for r in self.records)),
+            warnings=[f"step {k}: {w}" for w, k in self.checks.items()],
+        )
+
+    def write(self, folder):
+        """steps.csv, contacts.csv, bodies.csv and the series into `folder` (rank 0)."""
+        contacts = [
+            dict(step=r["step"], **{c: p[c] for c in CONTACT_COLUMNS[1:]})
+            for r in self.records
+            for p in r["pairs"]
+        ]
+        bodies = [
+            dict(
+                step=r["step"],
+                body=b.name,
+                fx=r["body_forces"][b.name][0],
+                fy=r["body_forces"][b.name][1],
+                moment=r["body_forces"][b.name][2],
+                area_levelset=r["area_levelset"][b.name],
+                volume_points=r["volume_points"][b.name],
+            )
+            for r in self.records
+            for b in self.sim.bodies
+        ]
+        write_csv(folder / "steps.csv", self.columns, self.rows)
+        write_csv(folder / "contacts.csv", CONTACT_COLUMNS, contacts)
+        write_csv(folder / "bodies.csv", BODY_COLUMNS, bodies)
+        for series in list(self.points_series.values()) + [self.grid_series]:
+            series.write(folder)
+
+    def outputs(self, plots=None):
+        """The keywords of `Run.finish` for a multi-step result folder: no single-step
+        solution, tractions or traction plot; the step files, then plots(run, folder)."""
+
+        def files(run, folder):
+            self.write(folder)
             if plots is not None:
                 plots(run, folder)
-            write_metrics(folder, metrics)
-    if comm.rank == 0:
-        for w in metrics["solver"]["warnings"]:
-            print(f"WARNING: {w}")
-        if summary is not None:
-            print(summary(run) if callable(summary) else summary.format(**metrics))
-        print(f"results in {Path(params['out']).resolve()}")
-    return 0
+
+        return dict(plot=None, files=files, solution=False, tractions=False)
 
 
 def binned_mean(x, values, size, max_bins=800):

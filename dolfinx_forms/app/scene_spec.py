@@ -55,8 +55,11 @@ from __future__ import annotations
 import ast
 import copy
 import math
+import re
 import tomllib
 from pathlib import Path
+
+import numpy as np
 
 from dolfinx_forms.common import SpecError  # noqa: F401  (raised here; its home is common)
 
@@ -80,6 +83,8 @@ SHAPES = {  # type -> (required, optional with defaults)
 }
 CHECK_ROOTS = ("results", "analytic", "solver", "mesh", "timing_s")
 FUNCTIONS = ("sqrt", "sin", "cos", "tan", "exp", "log", "abs")
+# a scene's name: the folder of its results under ./results (no path, nothing outside)
+NAME = re.compile(r"[A-Za-z0-9_.-]{1,100}")
 _REQUIRED = object()
 
 
@@ -110,10 +115,24 @@ def _box(v, key):
     return [lo, hi]
 
 
+MAX_EXPRESSION = 1000  # characters of an expression
+MAX_EXPONENT = 100  # |constant exponent| of a power
+# where an expression is tried at validation: a few generic points (no zeros, no symmetries)
+SAMPLES = np.array([[0.37, 1.13, 2.71, -0.59, 5.3], [0.83, -1.7, 0.11, 3.9, 2.2]])
+
+
 def parse_expression(text, key, names=("x", "y", "z")):
-    """Check an expression (number or string) and return it (a float or the string)."""
+    """Check an expression (number or string) and return it (a float or the string). A string
+    is at most MAX_EXPRESSION characters of arithmetic on the names, numbers and FUNCTIONS;
+    every power has a constant exponent of size at most MAX_EXPONENT (so no `9**9**9`); it is
+    evaluated once at SAMPLES (floats: no integer overflow, no exception) and refused if it is
+    finite at none of them (`1/0`, `sqrt(-1.0)`, `exp(1000.0)`)."""
     if not isinstance(text, str):
         return _number(text, key)
+    if len(text) > MAX_EXPRESSION:
+        raise SpecError(
+            key, f"an expression of at most {MAX_EXPRESSION} characters, got {len(text)}"
+        )
     try:
         tree = ast.parse(text, mode="eval")
     except SyntaxError:
@@ -146,7 +165,41 @@ def parse_expression(text, key, names=("x", "y", "z")):
             raise SpecError(key, f"unsupported syntax in {text!r}")
         if isinstance(node, ast.Constant) and not isinstance(node.value, (int, float)):
             raise SpecError(key, f"only numbers are allowed in {text!r}")
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
+            e = node.right
+            if isinstance(e, ast.UnaryOp) and isinstance(e.op, (ast.USub, ast.UAdd)):
+                e = e.operand
+            if not (isinstance(e, ast.Constant) and abs(e.value) <= MAX_EXPONENT):
+                raise SpecError(
+                    key, f"a power's exponent must be a number in [-{MAX_EXPONENT}, "
+                    f"{MAX_EXPONENT}] in {text!r}"
+                )
+    if not np.any(np.isfinite(_sample(tree, names))):
+        raise SpecError(
+            key, f"{text!r} is not a finite number (tried at {SAMPLES.shape[1]} points)"
+        )
     return text
+
+
+def _sample(tree, names):
+    """The expression `tree` (checked by parse_expression) at SAMPLES, in float64 numpy."""
+    env = {n: SAMPLES[i % 2] for i, n in enumerate(names)}
+    env.update({f: getattr(np, f) for f in FUNCTIONS}, pi=np.pi, np=np)
+    code = compile(ast.fix_missing_locations(_FloatConstants().visit(tree)), "<spec>", "eval")
+    with np.errstate(all="ignore"):
+        try:
+            v = eval(code, {"__builtins__": {}}, env)  # names, numbers and FUNCTIONS only
+        except (ArithmeticError, ValueError):
+            return np.full(SAMPLES.shape[1], np.nan)
+    return np.broadcast_to(np.asarray(v, dtype=float), SAMPLES.shape[1:])
+
+
+class _FloatConstants(ast.NodeTransformer):
+    """Integer constants as numpy floats: `1/0` and `2**1000` overflow to inf, not raise."""
+
+    def visit_Constant(self, node):
+        f = ast.Attribute(ast.Name("np", ast.Load()), "float64", ast.Load())
+        return ast.Call(f, [node], [])
 
 
 class _Table:
@@ -528,7 +581,14 @@ def validate(data, base_dir=None, default_name="scene"):
     """Check a description (a dict, as read from TOML) and return a new dict with every
     default filled in. Raises SpecError naming the first bad key."""
     top = _Table(copy.deepcopy(data), "")
-    spec = {"name": top.string("name", default_name), "description": top.string("description", "")}
+    # a file's name gives the default, made plain ("my scene.toml": "my_scene")
+    default_name = re.sub(r"[^A-Za-z0-9_.-]", "_", default_name)[:100].strip(".") or "scene"
+    name = top.string("name", default_name)
+    if not NAME.fullmatch(name) or name in (".", ".."):
+        raise SpecError(
+            "name", f"a plain file name (letters, digits, '-', '_', '.'; at most 100), got {name!r}"
+        )
+    spec = {"name": name, "description": top.string("description", "")}
     spec["discretization"] = _discretization(top.table("discretization"))
     spec["solver"] = _solver(top.table("solver", {}))
 
@@ -714,6 +774,8 @@ def _read(path, seen=()):
         raise SpecError(str(path), f"cannot read the description ({e.strerror})") from None
     except tomllib.TOMLDecodeError as e:
         raise SpecError(str(path), f"not valid TOML ({e})") from None
+    except UnicodeDecodeError as e:
+        raise SpecError(str(path), f"not a UTF-8 text file (byte {e.start}: {e.reason})") from None
     base = data.pop("extends", None)
     if base is None:
         return data

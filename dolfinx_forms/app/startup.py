@@ -9,7 +9,8 @@ imported. The library itself (`import dolfinx_forms`) does none of this.
 * one OpenBLAS thread per MPI rank under mpirun (the ranks already share the cores);
 * UFL's and FFCx's version look-up without scanning every installed distribution;
 * quiet JIT loggers (app/logs.py) and, under mpirun, an error on one rank ends every rank
-  (app/mpi_errors.py).
+  (app/mpi_errors.py); in a single process Ctrl-C (SIGINT) ends the program with one line
+  and status 130, not a traceback (`interrupted`).
 """
 
 import os
@@ -104,3 +105,19 @@ def start():
         os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     _import_ufl_ffcx()
     _setup_mpi()
+    if sys.excepthook is sys.__excepthook__:  # not under mpirun (mpi_errors' hook), nor IPython
+        sys.excepthook = interrupted
+
+
+def interrupted(kind, value, tb):
+    """sys.excepthook: KeyboardInterrupt as one line "<prog>: interrupted" and status 130 (the
+    shell's for SIGINT); anything else as Python reports it. The result folder is already
+    cleaned up by then (folders.atomic_output_dir)."""
+    if not issubclass(kind, KeyboardInterrupt):
+        return sys.__excepthook__(kind, value, tb)
+    from dolfinx_forms.common import program_name
+
+    sys.stdout.flush()
+    sys.stderr.write(f"{program_name()}: interrupted\n")
+    sys.stderr.flush()
+    os._exit(130)

@@ -153,6 +153,18 @@ def _not_ours(out: Path) -> str:
     )
 
 
+def _existing_ancestor(path):
+    """The nearest existing folder at or above `path` (a name too long for the file system
+    is not there)."""
+    for anc in (path, *path.parents):
+        try:
+            if anc.exists():
+                return anc
+        except OSError:
+            continue
+    return Path("/")
+
+
 def check_output_path(text, force=False) -> Path:
     """Validate --out before any computation; returns the resolved path.
 
@@ -165,6 +177,14 @@ def check_output_path(text, force=False) -> Path:
     if text.strip() == "":
         raise OutputFolderError("--out: must be a folder path, got ''")
     out = Path(text).resolve()
+    # the folder is built as ".<name>.XXXXXXXX.partial" beside it, then renamed
+    longest = max(len(os.fsencode(c)) for c in out.parts)
+    limit = os.pathconf(_existing_ancestor(out), "PC_NAME_MAX") - len(".._XXXXXXXX.partial")
+    if longest > limit:
+        raise OutputFolderError(
+            f"--out: a folder name of at most {limit} bytes (the file system's limit less the "
+            f"temporary folder's affixes), got one of {longest}"
+        )
     why = _forbidden(text, out)
     if why:
         raise OutputFolderError(f"--out: {text} is {why}; give a folder of its own")

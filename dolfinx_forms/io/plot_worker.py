@@ -1,7 +1,7 @@
 """Line plots (output.plot_lines), drawn in this process or in a worker process started early.
 
 A demo's default plot (tractions.png) costs ~0.5 s of a ~1.5 s process: matplotlib's import
-(0.3-0.4 s) and the drawing (0.1 s). When a core is idle, `start()` (demo.run_case, before the
+(0.3-0.4 s) and the drawing (0.1 s). When a core is idle, `start()` (demo.Run, before the
 run computes) launches `python3 -P plot_worker.py`, which imports matplotlib while the run
 computes, then draws the one figure it receives, replies and exits at once; the figure is the
 one `draw` makes in-process (same code, same matplotlib, same PNG bytes). A demo starts it

@@ -134,10 +134,18 @@ def import_gmsh():
     RTLD_DEEPBIND (its own dependencies searched first; the same shared objects, already
     loaded, are bound). gmsh.py's own load then finds the library open. Where the preload is
     not possible (no libgmsh, no RTLD_DEEPBIND) gmsh.py loads it as usual."""
+    import signal
     import sys
 
     if "gmsh" not in sys.modules:
         _preload_libgmsh()
+        handler = signal.getsignal(signal.SIGINT)
+        import gmsh
+
+        # gmsh.py sets SIGINT to the default action (a plain kill, no clean-up) at import;
+        # the program's own handling (Python's KeyboardInterrupt) comes back
+        if handler is not None:
+            signal.signal(signal.SIGINT, handler)
     import gmsh
 
     return gmsh

@@ -11,7 +11,7 @@ too). RESULTS.json: per case {"code": exit status, "status": ..., "stdout", "std
 
 * "exit": main raised SystemExit (code: its status, as the interpreter would report it),
 * "returned": main returned (code: its value, as `sys.exit(main())` would give),
-* "computed": main got past its argument checks (it called the demo's Run, run_steps or
+* "computed": main got past its argument checks (it called the demo's Run or
   sweep, replaced here by a function that raises): a bad command line that was not refused,
 * "exception": any other exception (its traceback is on the captured stderr, code 1),
 * "timeout": the case took longer than 60 s (SIGALRM),
@@ -31,7 +31,7 @@ import traceback
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-GUARDED = ("Run", "run_steps", "sweep")  # where a demo starts computing
+GUARDED = ("Run", "sweep")  # where a demo starts computing
 TIMEOUT = 60
 
 

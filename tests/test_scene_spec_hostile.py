@@ -1,0 +1,61 @@
+"""Hostile scene descriptions are refused at validation, in-process, with one line naming the
+key (issue 29): a name that is a path, expressions that hang or are not finite, a file that is
+not UTF-8 text. Values that are fine stay accepted."""
+
+from pathlib import Path
+
+import pytest
+
+from dolfinx_forms.app.scene_spec import SpecError, load, parse_expression
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = ROOT / "demos" / "scenes" / "two_blocks.toml"
+
+
+@pytest.mark.parametrize(
+    "text, why",
+    [
+        ("9**9**9", "exponent"),  # a hang: 9**(9**9) as integers
+        ("x**(2*x)", "exponent"),
+        ("1/0", "not a finite number"),
+        ("sqrt(-1.0)", "not a finite number"),
+        ("exp(1000.0)", "not a finite number"),
+        ("log(0*x)", "not a finite number"),
+        ("x" * 1001, "at most 1000 characters"),
+        ("__import__('os')", "may be called"),
+        ("x.real", "unsupported syntax"),
+    ],
+)
+def test_bad_expressions_refused(text, why):
+    """Refused by inspection or one float evaluation: `9**9**9` is never computed."""
+    with pytest.raises(SpecError, match=why) as e:
+        parse_expression(text, "dirichlet[2].value")
+    assert str(e.value).startswith("dirichlet[2].value: ")
+    assert "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize("text", ["-0.01 * x", "x**2 + 1/x", "(9**9)**9", "2**-3", "abs(y)"])
+def test_good_expressions_accepted(text):
+    """Finite at some sample point (1/x is finite away from x = 0, as on a real boundary)."""
+    assert parse_expression(text, "v") == text
+
+
+@pytest.mark.parametrize("name", ["/some/absolute/path", "../../x", "", "..", "a/b", "a b"])
+def test_name_is_a_plain_file_name(name):
+    with pytest.raises(SpecError, match="^name: a plain file name"):
+        load(SCENE, [f'name="{name}"'])
+
+
+def test_default_name_from_a_file_name_is_made_plain(tmp_path):
+    scene = tmp_path / "my scene.toml"
+    text = SCENE.read_text()
+    scene.write_text(text.replace('name = "two_blocks"\n', ""))
+    assert load(scene)["name"] == "my_scene"
+
+
+def test_binary_file_is_one_line(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_bytes(b'name = "x"\n\xff\xfe\x00 bad\n')
+    with pytest.raises(SpecError, match="not a UTF-8 text file") as e:
+        load(bad)
+    assert "\n" not in str(e.value)
