@@ -59,16 +59,64 @@ def test_error_on_one_rank_ends_all(tmp_path):
 
 
 def test_hook_only_in_parallel():
+    """The library installs no hook; the application's start-up in one process installs the
+    one-line Ctrl-C hook (startup.interrupted), not the MPI one."""
+    code = (
+        "import sys, dolfinx_forms; a = sys.excepthook is sys.__excepthook__; "
+        "import dolfinx_forms.app.startup as s; import dolfinx_forms.app; "
+        "print(a, sys.excepthook is s.interrupted)"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0 and r.stdout.strip() == "True True", r.stderr
+
+
+def test_solver_failure_on_one_rank_ends_all(tmp_path):
+    """A ContactSolverError on rank 1 alone inside a demo's Run block (a step's geometry
+    failing on that rank's part) while rank 0 goes on to its next collective: every rank ends
+    within seconds, with the message, no traceback (it was a hang: the failing rank returned
+    status 1 and the other waited)."""
+    script = textwrap.dedent(
+        """
+        from mpi4py import MPI
+        from dolfinx_forms.app.demo import Run
+        from dolfinx_forms.solvers.newton import ContactSolverError
+        comm = MPI.COMM_WORLD
+        with Run("probe", {"out": "never"}, plot=False) as run:
+            if comm.rank == 1:
+                raise ContactSolverError("step 3: projection failed at point 7")
+            comm.barrier()  # rank 0 would wait here forever
+        """
+    )
+    (tmp_path / "fail_in_run.py").write_text(script)
+    r, wall = mpirun(["fail_in_run.py"], timeout=120, cwd=tmp_path)
+    assert r.returncode != 0
+    assert wall < 30, f"took {wall:.1f} s"
+    assert "fail_in_run.py: error on rank 1: step 3: projection failed at point 7" in r.stderr
+    assert "Traceback" not in r.stderr
+    assert not (tmp_path / "never").exists()
+
+
+def test_ranks_given_different_command_lines_refused(tmp_path):
+    """mpirun's MPMD form gives each rank its own arguments: refused on every rank, exit 2,
+    nothing written (rank 1 alone given --h 0 used to hang)."""
+    exe = shutil.which("mpirun")
+    if exe is None or MPI.COMM_WORLD.size > 1:
+        pytest.skip("no mpirun, or already under mpirun (no nested launch)")
+    demo, out = str(ROOT / "demos" / "patch_test.py"), str(tmp_path / "out")
+    t0 = time.perf_counter()
     r = subprocess.run(
-        [
-            sys.executable,
-            "-c",
-            "import sys, dolfinx_forms; " "print(sys.excepthook is sys.__excepthook__)",
-        ],
+        [exe, "-n", "1", sys.executable, demo, "--out", out, ":"]
+        + ["-n", "1", sys.executable, demo, "--h", "0", "--out", out],
         capture_output=True,
         text=True,
+        env=dict(os.environ, **MPI_ENV),
+        timeout=120,
     )
-    assert r.returncode == 0 and r.stdout.strip() == "True", r.stderr
+    assert r.returncode == 2, r.stderr
+    assert time.perf_counter() - t0 < 30
+    lines = [ln for ln in r.stderr.splitlines() if "different command lines" in ln]
+    assert len(lines) == 2, r.stderr
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_bad_argument_exit_2_on_every_rank(tmp_path):

@@ -72,6 +72,7 @@ class DemoParser(argparse.ArgumentParser):
         self._out_dest = "out"
 
     def parse_args(self, args=None, namespace=None):
+        same_on_every_rank(self, sys.argv[1:] if args is None else args)
         a = super().parse_args(args, namespace)
         if getattr(self, "_discretization", False):  # add_discretization
             check_discretization(self, a)
@@ -504,6 +505,23 @@ def check_discretization(parser, args):
     """The cut path is vector Q1 on quadrilaterals."""
     if args.discretization == "cut" and getattr(args, "degree", 1) != 1:
         parser.error(f"--degree: the cut discretization supports degree 1 only, got {args.degree}")
+
+
+def same_on_every_rank(parser, argv):
+    """Under mpirun every rank parses its own command line: ranks given different ones would
+    take different paths and wait for each other forever. Refused on every rank (exit 2)."""
+    from mpi4py import MPI
+
+    comm = MPI.COMM_WORLD
+    if comm.size == 1:
+        return
+    lines = comm.allgather([str(a) for a in argv])
+    other = next((r for r, line in enumerate(lines) if line != lines[0]), None)
+    if other is not None:
+        parser.error(
+            f"the MPI ranks were given different command lines (rank 0: {' '.join(lines[0])!r}, "
+            f"rank {other}: {' '.join(lines[other])!r})"
+        )
 
 
 def exit_process(status):

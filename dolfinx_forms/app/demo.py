@@ -93,6 +93,13 @@ class Run:
 
             output.stop_plot_worker()
         if kind is not None and issubclass(kind, ContactSolverError):
+            if self.comm.size > 1:
+                # one rank may fail alone (a step's geometry on its part): the others would
+                # wait for it in their next collective, so this rank ends them all
+                sys.stdout.flush()
+                sys.stderr.write(f"{self.prog}: error on rank {self.comm.rank}: {error}\n")
+                sys.stderr.flush()
+                self.comm.Abort(1)
             if self.rank0:
                 sys.stderr.write(f"{self.prog}: {error}\n")
             self.status = 1
