@@ -168,3 +168,13 @@ def test_import_has_no_side_effects(tmp_path):
     assert r.returncode == 0, r.stderr
     got = json.loads(r.stdout.strip().splitlines()[-1])
     assert got == dict(changed=[], children=[], app=[], heavy=[])
+
+
+def test_tests_mirror_the_packages():
+    """Each sub-package of dolfinx_forms has its folder of tests (tests/<sub-package>/), and
+    no test module sits loose at the top but the structure, install and binding checks."""
+    package = ROOT / "dolfinx_forms"
+    subs = sorted(p.name for p in package.iterdir() if (p / "__init__.py").exists())
+    assert subs and all((ROOT / "tests" / s).is_dir() for s in subs), subs
+    loose = sorted(p.name for p in (ROOT / "tests").glob("test_*.py"))
+    assert loose == ["test_bindings.py", "test_install.py", "test_layout.py"]

@@ -10,7 +10,7 @@ used until the package was split): the two agree on every scene of equal moduli 
 patch test, two blocks, the grain assemblies, whose softest contact is grain on grain); they
 differ where moduli differ or a body touches only rigid obstacles. A soft disc (E 200) between
 stiff blocks (E 1e5): the mean gives 66733, the contact 399, and the mean's penalty was 167
-times too stiff there (a checkerboard, tests/test_scenes.py). A disc between rigid platens
+times too stiff there (a checkerboard, tests/app/test_scenes.py). A disc between rigid platens
 (the Brazilian disc): E_c = 2 E, the harmonic mean with an infinitely stiff partner, as the
 contact compliance of Hertz's E* halves against a rigid flat; the demo's default eps0 doubled
 with it (0.3 -> 0.6: the same eps_n, the same figures).

@@ -275,7 +275,7 @@ class Iterative:
     J with those rows and columns replaced by the identity, which is symmetric positive
     definite where the bulk and the contact tangent are: a linear bulk with frictionless
     penalty contact (the tangent of eq 48 then is symmetric: |A - A^T| / |A| = 6e-17 on Hertz,
-    `tests/test_iterative.py`).
+    `tests/solvers/test_iterative.py`).
     Friction (slip: a non-symmetric tangent) or a nonlinear law switch the Krylov method to
     GMRES (`krylov`), with the same preconditioner.
 

@@ -31,7 +31,7 @@ class NewtonOptions:
     line_search: bool = True  # halve a Newton step that does not lower the residual
     # friction: the first iteration of a step is the elastic predictor (every closed point
     # sticks: residual and tangent of an infinite mu), the return mapping from the next on. A
-    # platen moved sideways by a step of a stuck block (tests/test_mpm.py): 1 Newton
+    # platen moved sideways by a step of a stuck block (tests/mpm/test_mpm.py): 1 Newton
     # iteration, where the slip the step's motion predicts cycled stick/slip through 4
     # cut-backs (16 sub-steps); Hertz-Mindlin, the blocks, the incline, nine discs and four
     # grains take the iterations they took, the Brazilian disc 4.98 per step instead of 4.84,

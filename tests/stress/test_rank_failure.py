@@ -1,10 +1,10 @@
 """Stress suite (issue 11, item 6): under `mpirun -n 2`, rank 0 alone fails while the demo
 writes its result folder (rank 1 is then waiting in the barrier that ends the writing): every
 rank ends within seconds with a non-zero status and one line naming the error, and nothing is
-left: no result folder, no temporary folder. tests/test_parallel_errors.py has the same for
+left: no result folder, no temporary folder. tests/app/test_parallel_errors.py has the same for
 rank 1 failing in a plain script; here it is rank 0, inside a demo's atomic folder
 (folders.atomic_output_dir). Serial test: it starts mpirun itself (helper of
-tests/test_parallel_errors.py)."""
+tests/app/test_parallel_errors.py)."""
 
 import importlib.util
 import os
@@ -13,7 +13,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 _spec = importlib.util.spec_from_file_location(
-    "_parallel_errors_helpers", ROOT / "tests" / "test_parallel_errors.py"
+    "_parallel_errors_helpers", ROOT / "tests" / "app" / "test_parallel_errors.py"
 )
 _helpers = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(_helpers)

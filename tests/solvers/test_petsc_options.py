@@ -11,7 +11,7 @@ import pytest
 
 from dolfinx_forms.app import cli
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.parametrize(

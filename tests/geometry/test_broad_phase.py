@@ -3,7 +3,7 @@ sort-and-sweep pairs equal an O(n^2) numpy reference exactly (same inflated doub
 boxes), touching counts, empty and bad input, and a timing measurement on grain packings
 (printed with -s; the only assertion there is on the pair count, never on time).
 
-Run the timing table alone: /usr/bin/python3 tests/test_broad_phase.py
+Run the timing table alone: /usr/bin/python3 tests/geometry/test_broad_phase.py
 """
 
 

@@ -8,7 +8,7 @@ import pytest
 
 from dolfinx_forms.app.scene_spec import SpecError, load, parse_expression
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCENE = ROOT / "demos" / "scenes" / "two_blocks.toml"
 
 

@@ -21,7 +21,7 @@ from dolfinx_forms.io.folders import (
     read_marker,
 )
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 NOT_OURS = "exists and is not a result folder of this code (use another path or --force)"
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 _spec = importlib.util.spec_from_file_location(
-    "nine_discs", Path(__file__).resolve().parents[1] / "demos" / "nine_discs.py"
+    "nine_discs", Path(__file__).resolve().parents[2] / "demos" / "nine_discs.py"
 )
 demo = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(demo)

@@ -12,7 +12,7 @@ import pytest
 from meshes.four_grains import grain_outlines, overlap
 
 _spec = importlib.util.spec_from_file_location(
-    "four_grains", Path(__file__).resolve().parents[1] / "demos" / "four_grains.py"
+    "four_grains", Path(__file__).resolve().parents[2] / "demos" / "four_grains.py"
 )
 demo = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(demo)

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-DEMO = Path(__file__).resolve().parents[1] / "demos" / "contact_geometry.py"
+DEMO = Path(__file__).resolve().parents[2] / "demos" / "contact_geometry.py"
 
 
 def run(*args):

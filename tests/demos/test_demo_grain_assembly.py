@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 _spec = importlib.util.spec_from_file_location(
-    "grain_assembly", Path(__file__).resolve().parents[1] / "demos" / "grain_assembly.py"
+    "grain_assembly", Path(__file__).resolve().parents[2] / "demos" / "grain_assembly.py"
 )
 demo = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(demo)

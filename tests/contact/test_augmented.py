@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 EXACT = 0.01 / (1 - 0.3**2) / 1.0  # E' d / H with E = 1, nu = 0.3, d = 0.01, H = 1
 
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 _spec = importlib.util.spec_from_file_location(
-    "brazilian_disc", Path(__file__).resolve().parents[1] / "demos" / "brazilian_disc.py"
+    "brazilian_disc", Path(__file__).resolve().parents[2] / "demos" / "brazilian_disc.py"
 )
 demo = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(demo)

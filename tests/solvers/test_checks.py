@@ -13,7 +13,7 @@ import pytest
 
 from dolfinx_forms.solvers.checks import PENETRATION, pair_warnings
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 H, BAND = 0.1, 0.2
 
 

@@ -20,7 +20,7 @@ import pytest
 from dolfinx_forms.analysis import analytic
 from dolfinx_forms.app.scene_spec import SpecError, load
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "demos" / "scenes"
 
 
