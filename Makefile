@@ -22,7 +22,7 @@ export PYTHONPATH := $(CURDIR)$(if $(PYTHONPATH),:$(PYTHONPATH))
 MPIRUN  ?= mpirun -n 2
 SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: deps bench-deps build warm test test-cpp test-python test-mpi demo bench format clean
+.PHONY: deps bench-deps build warm test test-cpp test-python test-mpi demo bench calibrate format clean
 
 # $(call apt_install,PACKAGES): install those of PACKAGES that are missing
 define apt_install
@@ -73,6 +73,10 @@ bench: build bench-deps
 	  --benchmark_out_format=json
 	$(PYTHON) benchmarks/plot_geometry.py benchmarks/results/geometry.json
 	$(PYTHON) benchmarks/work_precision.py --out-dir benchmarks/results
+
+# the studies behind dolfinx_forms/defaults.py's tuned numbers (a few minutes)
+calibrate: build
+	$(PYTHON) benchmarks/calibration.py --out-dir benchmarks/results
 
 format:
 	clang-format -i cpp_contact/*/*.h cpp_contact/*/*.cpp

@@ -46,10 +46,10 @@ from mpi4py import MPI
 
 from benchmarks.common import git_head, write_atomic
 from dolfinx_forms.app.cli import DemoParser, bounded
+from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.fem.laws import LinearElastic, OrthotropicElastic
 from dolfinx_forms.io.output import gather_points, window_average
 from dolfinx_forms.solvers.problem import ContactProblem, zone_ends
-from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.solvers.protocol import ramp
 from meshes.cut import hertz_cut_scene
 from meshes.hertz import ellipse_sag, hertz_scene

@@ -95,8 +95,8 @@ def _reference_timed(discretization, divisor, timer):
     from mpi4py import MPI
     from petsc4py import PETSc
 
-    from dolfinx_forms.solvers.problem import ContactProblem
     from dolfinx_forms.fem.boundary import Dirichlet
+    from dolfinx_forms.solvers.problem import ContactProblem
 
     hertz = hertz_demo()
     p = vars(hertz.parse(["--discretization", discretization]))

@@ -51,8 +51,8 @@ from mpi4py import MPI
 from dolfinx_forms.analysis import analytic
 from benchmarks.common import git_head, write_atomic
 from dolfinx_forms.app.cli import DemoParser, bounded
-from dolfinx_forms.solvers.problem import ContactProblem
 from dolfinx_forms.solvers.newton import ContactSolverError
+from dolfinx_forms.solvers.problem import ContactProblem
 from meshes.cut import patch_cut_scene
 from meshes.patch import patch_dirichlet
 

@@ -87,8 +87,8 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.common import git_head, load_script, write_atomic, write_json
-from dolfinx_forms.app.cli import DemoParser
 from dolfinx_forms.app import study
+from dolfinx_forms.app.cli import DemoParser
 from dolfinx_forms.app.study import last_line
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -30,9 +30,8 @@ import numpy as np
 from dolfinx_forms.analysis import analytic, compare, post
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
-from dolfinx_forms.fem.boundary import nearest_vertex_marker
+from dolfinx_forms.fem.boundary import Dirichlet, nearest_vertex_marker
 from dolfinx_forms.io.output import plot_lines
-from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.solvers.protocol import friction_on, ramp
 from meshes.cut import cut_counts, incline_cut_scene
 from meshes.incline import incline_scene

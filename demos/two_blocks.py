@@ -32,8 +32,8 @@ import ufl
 from dolfinx_forms.analysis import compare, post
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
-from dolfinx_forms.io.output import write_columns
 from dolfinx_forms.fem.boundary import Dirichlet, Traction
+from dolfinx_forms.io.output import write_columns
 from dolfinx_forms.solvers.protocol import friction_on, ramp
 from meshes.cut import cut_counts, two_blocks_cut_scene
 from meshes.two_blocks import two_blocks_scene

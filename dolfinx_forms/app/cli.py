@@ -15,6 +15,7 @@ import math
 import re
 import sys
 
+from dolfinx_forms import defaults
 from dolfinx_forms.app.logs import set_verbose
 from dolfinx_forms.io.folders import OutputFolderError, check_output_path
 
@@ -78,10 +79,8 @@ class DemoParser(argparse.ArgumentParser):
             check_discretization(self, a)
         if getattr(self, "_petsc_dest", None) is not None:  # add_petsc: KEY=VALUE -> dict
             # the trial solve reads the options on top of the chosen solver's defaults
-            defaults = (
-                ITERATIVE_DEFAULTS if getattr(a, "linear_solver", "") == "iterative" else None
-            )
-            opts = petsc_options(self, getattr(a, self._petsc_dest), defaults)
+            base = ITERATIVE_DEFAULTS if getattr(a, "linear_solver", "") == "iterative" else None
+            opts = petsc_options(self, getattr(a, self._petsc_dest), base)
             setattr(a, self._petsc_dest, opts)
         given = sys.argv[1:] if args is None else args
         if getattr(a, "multiplier_mass", None) is not None and a.enforcement != "augmented":
@@ -95,7 +94,7 @@ class DemoParser(argparse.ArgumentParser):
             and hasattr(a, "eps0")
             and not any(t == "--eps0" or str(t).startswith("--eps0=") for t in given)
         ):
-            a.eps0 = AUGMENTED_EPS0  # eps0 sets the loop's speed only: the fast one
+            a.eps0 = defaults.TUNING.augmented_eps0  # eps0 sets the loop's speed only: the fast one
         if getattr(a, "verbose", False):
             set_verbose(True)
         if self._out_dest is not None:
@@ -420,10 +419,6 @@ def check_scale(parser, args, size, what, max_cells=2000, displacement=True):
         )
 
 
-# --eps0 of --enforcement augmented unless given: eps0 then sets only the Uzawa loop's speed
-# (its step relaxed by min(1, solver.POINTWISE_EPS0 / eps0): any eps0 <= 2 is the full step;
-# Hertz at h = a/20: 11 / 9 updates body-fitted / cut at 1e-2, 31 / 27 at 1e2)
-AUGMENTED_EPS0 = 1e-2
 
 
 # the multi-step MPM runs the penalty only (`mpm.ImplicitMPM` refuses the other: its grains'
@@ -442,7 +437,7 @@ def add_enforcement(parser, choices=("penalty", "augmented")):
         help=(
             "contact enforcement: penalty (the answer depends on --eps0) or augmented "
             "(augmented Lagrangian, P1 multipliers along the contact: --eps0 sets only the "
-            f"loop's speed, default {AUGMENTED_EPS0:g} with it)"
+            f"loop's speed, default {defaults.TUNING.augmented_eps0:g} with it)"
             if "augmented" in choices
             else "contact enforcement: the multi-step MPM runs the penalty only"
         ),

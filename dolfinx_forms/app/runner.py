@@ -26,8 +26,8 @@ import numpy as np
 from mpi4py import MPI
 
 from dolfinx_forms.analysis import analytic, compare
-from dolfinx_forms.solvers import protocol
 from dolfinx_forms.app.scene_spec import FUNCTIONS, SpecError, load, make_law
+from dolfinx_forms.solvers import protocol
 
 __all__ = ["run", "RunResult", "evaluate_checks"]
 DISCRETIZATION_NAMES = {"cut": "cut", "fitted": "conforming"}  # metrics.json names

@@ -335,7 +335,7 @@ def _discretization(t):
 
 
 def _solver(t):
-    from dolfinx_forms.app.cli import AUGMENTED_EPS0
+    from dolfinx_forms import defaults
 
     enforcement = t.string("enforcement", "penalty", choices=["penalty", "augmented"])
     from dolfinx_forms.geometry.pairs import DEFAULT_MULTIPLIER_MASS, MULTIPLIER_MASSES
@@ -346,7 +346,7 @@ def _solver(t):
             t.path("multiplier_mass"), 'needs enforcement = "augmented" (the penalty has none)'
         )
     # augmented: eps0 sets only the Uzawa loop's speed (the demos' --eps0 default likewise)
-    eps0 = 1.0 if enforcement == "penalty" else AUGMENTED_EPS0
+    eps0 = 1.0 if enforcement == "penalty" else defaults.TUNING.augmented_eps0
     s = dict(
         enforcement=enforcement,
         multiplier_mass=mass or (DEFAULT_MULTIPLIER_MASS if enforcement == "augmented" else None),

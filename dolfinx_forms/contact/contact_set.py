@@ -29,8 +29,8 @@ stabilised mortar constraint of size eps_n h^2 lambda'' (Hertz: 7.5e-4 h), while
 keeps the point-wise shape of the gap between the nodes: the contact edge and the stick/slip
 boundary fall between nodes as with the penalty (Hertz at h = a/20: p(x) 0.91 % body-fitted,
 1.19 % cut, against 2.43 % and 3.46 % with traction "nodes"). eps_n and eps_t are then part
-of the discretisation (`solver.POINTWISE_EPS0`, `POINTWISE_EPS0_T`), and the user's eps0 only
-relaxes the Uzawa step (`relaxation` <= 1). A zero mean gap at every active node instead
+of the discretisation (`defaults.TUNING`: pointwise_eps0, pointwise_eps0_t), and the user's eps0
+only relaxes the Uzawa step (`relaxation` <= 1). A zero mean gap at every active node instead
 (Uzawa on the nodes' weighted mean gaps, lambda <- min(0, lambda + M_L^-1 int psi (tau -
 lambda_h)) node by node) converges to 1e-9 h, but its pressure depends on where the nodes fall
 against the contact edge: Hertz at h = 0.05, loads 350-520 (nodes 1.25 h apart, eps 1.5 h/E:
@@ -42,16 +42,16 @@ weighted mean gap and every other one a gap >= 0 (int_open psi (eps lambda_h + g
 of a coarser pressure (Hertz a/20: 1.16 % / 1.53 %, 1.0-1.3 % body-fitted over loads 350-520);
 its multipliers are left unclipped (`admissible`).
 multiplier_mass "hybrid" (the default with "augmented") takes from each what it does well
-(`PairGeometry.hybrid_projection`): a node whose hat is mostly in contact (HYBRID_CLOSED_FRACTION
-of its weight on closed points) gets the consistent row, so int psi_i g >= 0 at the fixed point
-and = 0 where the hat is all in contact; the nodes at and past the contact edge keep the lumped
-row, which does not fit the square-root edge by an overshooting L2 fit. Tangential tractions
-are projected lumped (the lumped q(x)); their regularisation is continued within each step
-(eps_t_start = 1.5 h/E until the loop nearly converges, `NewtonOptions.al_switch`, then eps_t =
-1 h/E, `solver.CONSISTENT_EPS0_T`): at 1.5 h/E alone the smoothed multipliers let points just
-past the stick/slip boundary stick (stick zone +0.49 % mean over 24 Mindlin runs, 0.17 % with
-the continuation). Where the loop cycles (a row switching as points open and close) the rows
-are frozen (`freeze_rows`). Hertz a/20, loads 350-520: p(x) 0.78-1.09 % body-fitted,
+(`PairGeometry.hybrid_projection`): a node whose hat is mostly in contact
+(defaults.TUNING.hybrid_closed_fraction of its weight on closed points) gets the consistent row, so
+int psi_i g >= 0 at the fixed point and = 0 where the hat is all in contact; the nodes at and past
+the contact edge keep the lumped row, which does not fit the square-root edge by an overshooting L2
+fit. Tangential tractions are projected lumped (the lumped q(x)); their regularisation is continued
+within each step (eps_t_start = 1.5 h/E until the loop nearly converges, `NewtonOptions.al_switch`,
+then eps_t = 1 h/E, `defaults.TUNING.consistent_eps0_t`): at 1.5 h/E alone the smoothed multipliers
+let points just past the stick/slip boundary stick (stick zone +0.49 % mean over 24 Mindlin runs,
+0.17 % with the continuation). Where the loop cycles (a row switching as points open and close) the
+rows are frozen (`freeze_rows`). Hertz a/20, loads 350-520: p(x) 0.78-1.09 % body-fitted,
 1.12-1.50 % cut, every weighted gap < 1e-9 h (docs/notes/design.md).
 Its multipliers are left unclipped too.
 """

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import basix
 import numpy as np
 
-from dolfinx_forms import _cpp
+from dolfinx_forms import _cpp, defaults
 from dolfinx_forms.geometry.obstacles import RigidObstacle
 
 
@@ -41,12 +41,8 @@ TRACTIONS = ("nodes", "points")
 # traction "points" (`PairGeometry.node_multipliers`)
 MULTIPLIER_MASSES = ("lumped", "consistent", "hybrid")
 DEFAULT_MULTIPLIER_MASS = "hybrid"  # with the augmented Lagrangian (`solver.ContactProblem`)
-# "hybrid": a node whose hat carries at least this fraction of its weight on closed points gets
-# the consistent row, the others the lumped row. Hertz a/20, loads 350-520, both paths: 0.75
-# gives weighted gaps < 1e-9 h and p(x) 0.78-1.09 % body-fitted, 1.12-1.50 % cut; 0.5 moves the
-# L2 fit's overshoot back to the edge (1.21 / 1.27 % body-fitted at loads 430 / 470); 1 (only
-# the nodes all in contact) leaves edge nodes at weighted gaps of 1e-4-5e-4 h
-HYBRID_CLOSED_FRACTION = 0.75
+# "hybrid": a node whose hat carries at least defaults.TUNING.hybrid_closed_fraction of its
+# weight on closed points gets the consistent row, the others the lumped row
 
 
 @dataclass
@@ -133,8 +129,8 @@ class PairGeometry:
 
     def hybrid_projection(self, point_values, closed):
         """Point values projected on the P1 multiplier nodes with one row per node: a node
-        whose hat has at least HYBRID_CLOSED_FRACTION of its weight on the closed points
-        (`closed`, bool per point) the consistent row, (M lambda)_i = int psi_i v; any other
+        whose hat has at least defaults.TUNING.hybrid_closed_fraction of its weight on the closed
+        points (`closed`, bool per point) the consistent row, (M lambda)_i = int psi_i v; any other
         node the lumped row (its hat-weighted mean). At Uzawa's fixed point the first have
         int psi_i g >= 0, zero when their hat is all in contact (the consistent projection's
         argument, row by row), and the second keep the lumped projection's edge: no L2 fit of
@@ -149,7 +145,7 @@ class PairGeometry:
             Wc = np.bincount(
                 nodes.ravel(), ((self.weights * closed)[:, None] * psi).ravel(), self.num_nodes
             )
-            rows_c = (Wc >= (HYBRID_CLOSED_FRACTION - 1e-12) * W) & (W > 0)
+            rows_c = (Wc >= (defaults.TUNING.hybrid_closed_fraction - 1e-12) * W) & (W > 0)
         self.hybrid_rows = rows_c
         key = rows_c.tobytes()
         if getattr(self, "_hybrid_key", None) != key:  # refactorised when the rows change

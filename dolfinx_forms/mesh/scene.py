@@ -137,17 +137,15 @@ def import_gmsh():
     import signal
     import sys
 
-    if "gmsh" not in sys.modules:
+    first, handler = "gmsh" not in sys.modules, signal.getsignal(signal.SIGINT)
+    if first:
         _preload_libgmsh()
-        handler = signal.getsignal(signal.SIGINT)
-        import gmsh
-
-        # gmsh.py sets SIGINT to the default action (a plain kill, no clean-up) at import;
-        # the program's own handling (Python's KeyboardInterrupt) comes back
-        if handler is not None:
-            signal.signal(signal.SIGINT, handler)
     import gmsh
 
+    # gmsh.py sets SIGINT to the default action (a plain kill, no clean-up) at import; the
+    # program's own handling (Python's KeyboardInterrupt) comes back
+    if first and handler is not None:
+        signal.signal(signal.SIGINT, handler)
     return gmsh
 
 

@@ -37,18 +37,14 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_forms import _cpp
+from dolfinx_forms import _cpp, defaults
 
 DEFAULT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
 # a symmetric bulk or Schur complement: |A - A^T| <= this * |A| (round-off of the assembly)
 SYMMETRY_RTOL = 1e-12
 MAX_CONDENSED = 6000  # the dense m x m blocks (3 of them) stay below ~1 GB
-# "auto" condenses only where m^3 <= CONDENSED_COST n^1.5: a Newton iteration costs a dense
-# m x m update (~m^3) instead of a sparse factorisation (~n^1.5 in 2D). Measured (m^3 / n^1.5,
-# solve phase condensed / factorised): Hertz a/20 ... a/80, both paths, 118-165, condensed
-# the faster (the reason it exists); Brazilian disc (3 steps) 6.6, 14.2 / 18.8 s over its
-# 50 steps; four grains 1250, 0.89 / 0.46 s; nine discs 4950, 2.49 / 0.63 s
-CONDENSED_COST = 400.0
+# "auto" condenses only where m^3 <= defaults.TUNING.condensed_cost n^1.5: a Newton iteration
+# costs a dense m x m update (~m^3) instead of a sparse factorisation (~n^1.5 in 2D)
 # Iterative's defaults: the Krylov method is chosen by the tangent's symmetry (Iterative)
 # threshold 0.05: 61 -> 40 CG iterations on body-fitted Hertz (45k dofs); Chebyshev smoothers
 # with their own 50-step eigenvalue estimates: GAMG's prolongator estimate misses the modes of
@@ -174,7 +170,7 @@ class Condensed:
     The dense update costs ~m^3 and a sparse factorisation ~n^1.5 (2D): should an update take
     longer than twice the sparse factorisation (and 50 ms), the solver hands over to
     `Factorised` for the rest of the run (`name` then says so); "auto" picks it only where m^3
-    <= CONDENSED_COST n^1.5 (`choose`)."""
+    <= defaults.TUNING.condensed_cost n^1.5 (`choose`)."""
 
     name = "condensed"
     min_handover = 0.05  # s: below this a dense update is never "too slow"
@@ -449,7 +445,7 @@ def choose(problem, kind="auto", petsc_options=None):
     "auto": Iterative for a body-fitted scene of at least ITERATIVE_MIN_DOFS dofs with the
     default solver options (or for options naming pc_type=gamg); else Condensed for a linear
     bulk on one process with the default direct solver and a contact block of m dofs well
-    below the n dofs, m^3 <= CONDENSED_COST n^1.5; Factorised otherwise."""
+    below the n dofs, m^3 <= defaults.TUNING.condensed_cost n^1.5; Factorised otherwise."""
     if kind not in KINDS:
         raise ValueError(f"linear_solver: {', '.join(map(repr, KINDS))}, not {kind!r}")
     default = not petsc_options or {**DEFAULT_OPTIONS, **petsc_options} == DEFAULT_OPTIONS
@@ -474,7 +470,8 @@ def choose(problem, kind="auto", petsc_options=None):
     m, n = (0, problem.num_dofs) if dofs is None else (len(dofs), problem.num_dofs)
     if why is None and not 0 < m <= min(MAX_CONDENSED, n // 4):
         why = f"{m} contact dofs of {n}"
-    if why is None and kind == "auto" and float(m) ** 3 > CONDENSED_COST * float(n) ** 1.5:
+    costly = float(m) ** 3 > defaults.TUNING.condensed_cost * float(n) ** 1.5
+    if why is None and kind == "auto" and costly:
         why = f"{m} contact dofs of {n}: a dense update would cost more than a factorisation"
     if why is None:
         return Condensed(problem, dofs, petsc_options)

@@ -21,46 +21,18 @@ from dolfinx import fem, la
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from dolfinx_forms.fem.boundary import dirichlet_dofs
-from dolfinx_forms.fem.bulk import BulkForms
-from dolfinx_forms.geometry.pairs import DEFAULT_MULTIPLIER_MASS, MULTIPLIER_MASSES, TRACTIONS
-from dolfinx_forms.solvers import blas, linear
+from dolfinx_forms import defaults
 from dolfinx_forms.contact.contact_set import ContactSet
 from dolfinx_forms.contact.penalty import contact_modulus, penalty_parameter
+from dolfinx_forms.fem.boundary import dirichlet_dofs
+from dolfinx_forms.fem.bulk import BulkForms
 from dolfinx_forms.fem.laws import as_law
+from dolfinx_forms.geometry.pairs import DEFAULT_MULTIPLIER_MASS, MULTIPLIER_MASSES, TRACTIONS
+from dolfinx_forms.solvers import blas, linear
 from dolfinx_forms.solvers.newton import NewtonOptions, load_steps
 
-# the augmented Lagrangian's point-wise regularisation with traction "points" (`contact_set`),
-# eps_n = POINTWISE_EPS0 h / E: Hertz at h = a/20 (P1 nodes h / 1.5 h apart) gives
-# p(x) 1.35 / 0.94 / 0.91 / 1.26 % body-fitted and 1.85 / 1.21 / 1.19 / 1.62 % cut at
-# 0.5 / 1 / 2 / 5; stiffer approaches the over-constrained point-wise contact (3.5 % at 0.1)
-POINTWISE_EPS0 = 2.0
-# the same with multiplier_mass "consistent" (zero weighted mean gap at the fixed point), with
-# P1 nodes CONSISTENT_LENGTH h apart on both paths. Hertz at a/20, p(x) body-fitted / cut:
-# eps 1 h/E, nodes 1.5 h apart 1.16 / 1.53 %; nodes h apart 1.30 / 2.70 %; eps 2 h/E with the
-# lumped spacing (h / 1.5 h) 1.39 / 1.66 %; eps 0.5 h/E and below 1.5-3.6 / 2.0-8.3 %
-# (docs/notes/design.md). "hybrid" likewise: at a/20 eps 1 / 1.5 / 2 h/E with nodes 1.5 h apart gave
-# 0.93 / 0.97 / 1.08 % body-fitted and 1.31 / 1.24 / 1.27 % cut (fully closed rows only; h
-# apart 1.06 / 1.85 %)
-CONSISTENT_EPS0 = 1.0
-CONSISTENT_LENGTH = 1.5
-# eps_t = POINTWISE_EPS0_T h / E: Cattaneo-Mindlin (Q = 0.5 mu P, mu 0.1 and 1, a/20 and a/10,
-# both paths) gives the stick half-width off by -0.3 ... +1.5 % at 1.25, -0.05 ... +1.7 % at
-# 1.5 (a/20: +0.1 % body-fitted, +0.35 % cut) and +0.6 ... +2.0 % at 2 (the penalty: +0.06 ...
-# +0.9 %); q(x) moves by at most 0.4 points of % over the three (docs/notes/design.md)
-POINTWISE_EPS0_T = 1.5
-# with multiplier_mass "consistent" or "hybrid" the tangential fixed point is at eps_t =
-# CONSISTENT_EPS0_T h / E, reached by continuation from POINTWISE_EPS0_T (each step's loop
-# nearly converges there first, `NewtonOptions.al_switch`: from the committed tractions Newton
-# cycles at 1.0). Mindlin, Q = 0.5
-# mu P, 24 runs (mu 0.1 / 0.3 / 1, h = a/16 ... a/28, both paths): stick half-width off by
-# 0.17 % mean |.|, 0.40 % at most (1.5 alone: 0.49 / 0.98 %; the penalty 0.33 / 0.52 %), q(x)
-# 5.50 % mean (5.41 %; penalty 5.66 %), 1-2 Newton iterations more than 1.5 alone; 0.75 gave
-# -0.15 ... -0.65 %
-CONSISTENT_EPS0_T = 1.0
-# below this many dofs one BLAS thread (`blas.threads_for`; measured on cut Hertz: one thread
-# as fast at 8.5k dofs and steadier, two 7 % faster at 1e5)
-BLAS_ONE_THREAD_DOFS = 50_000
+# the tuned factors of the augmented Lagrangian's regularisation and the BLAS threshold are
+# read from dolfinx_forms.defaults.TUNING when a problem is made (their studies: STUDIES there)
 
 
 class ContactProblem:
@@ -92,13 +64,15 @@ class ContactProblem:
     p(x) 1.9 / 2.3 / 3.1 % body-fitted at 0.75 / 1 / 1.5 h, 3.9 / 3.4 % cut at 1 / 1.5 h, with
     traction "nodes"). traction: "nodes" (the law on each node's weighted mean gap) or "points"
     (the law at each point with the multipliers interpolated, `contact_set`; the kernel's eps_n
-    and eps_t are then POINTWISE_EPS0 and POINTWISE_EPS0_T times h / E_c (eq 51), and
+    and eps_t are then the tuned factors pointwise_eps0 and pointwise_eps0_t (defaults.TUNING)
+    times h / E_c (eq 51), and
     eps0 relaxes the Uzawa step by min(1, eps_n / eps));
     default "points" with "augmented". multiplier_mass (augmented, P1, traction "points"):
     "hybrid" (default: zero weighted gap on the closed part of every node mostly in contact,
     the lumped projection at the contact edge), "consistent" (zero weighted mean gap at every
     node in contact, a coarser pressure) or "lumped" (weighted gaps ~1e-3 h); the first two
-    with eps_n = CONSISTENT_EPS0 h / E and nodes CONSISTENT_LENGTH h apart by default
+    with eps_n = consistent_eps0 h / E_c and nodes consistent_length h apart by default
+    (defaults.TUNING)
     (`contact_set`).
     linear_solver: "auto", "condensed", "factorised" or "iterative" (`linear.py`: a linear bulk
     on one process is factorised once, with Newton on the Schur complement of the contact dofs;
@@ -182,7 +156,8 @@ class ContactProblem:
             self.num_dofs = imap.size_global * self.bs
             # small problems (and MPI ranks sharing the cores) run their dense kernels on one
             # BLAS thread: faster, and no spinning threads waiting for a busy core (`blas`)
-            blas.threads_for(self.comm.size > 1 or self.num_dofs < BLAS_ONE_THREAD_DOFS)
+            small = self.num_dofs < defaults.TUNING.blas_one_thread_dofs
+            blas.threads_for(self.comm.size > 1 or small)
             all_bc = (
                 np.unique(np.concatenate(self.bc_dofs)) if self.bc_dofs else np.zeros(0, np.int32)
             )
@@ -214,19 +189,19 @@ class ContactProblem:
                 f"multipliers and traction 'points', got {enforcement!r}, {multipliers!r}, "
                 f"{traction!r}"
             )
-        relaxation, eps_t_start = 1.0, None
+        relaxation, eps_t_start, tune = 1.0, None, defaults.TUNING
         if enforcement == "augmented" and multipliers is not None and traction == "points":
             # the point-wise regularisation is part of the discretisation; eps0 sets the step
-            fine = penalty_parameter(CONSISTENT_EPS0 if consistent else POINTWISE_EPS0, h, E_c)
+            k_n = tune.consistent_eps0 if consistent else tune.pointwise_eps0
+            fine = penalty_parameter(k_n, h, E_c)
             relaxation = min(1.0, fine / self.eps_n)
-            self.eps_n, self.eps_t = fine, penalty_parameter(POINTWISE_EPS0_T, h, E_c)
+            self.eps_n, self.eps_t = fine, penalty_parameter(tune.pointwise_eps0_t, h, E_c)
             eps_t_start = self.eps_t
             if consistent:
-                self.eps_t = penalty_parameter(CONSISTENT_EPS0_T, h, E_c)
+                self.eps_t = penalty_parameter(tune.consistent_eps0_t, h, E_c)
         if multiplier_length is None:
-            multiplier_length = h * (
-                CONSISTENT_LENGTH if consistent else 1.5 if self.integration is not None else 1.0
-            )
+            spacing = 1.5 if self.integration is not None else 1.0  # the lumped projection's
+            multiplier_length = h * (tune.consistent_length if consistent else spacing)
         with self.phase("contact"):
             self.contact = ContactSet(
                 self.V,

@@ -112,8 +112,8 @@ def test_patch_scene_augmented(tmp_path, mass):
 def test_soft_disc_between_stiff_blocks_augmented(tmp_path, h):
     """A neo-Hookean disc (E = 200) squeezed between linear blocks (E = 1e5), augmented.
     The point-wise regularisation is scaled by the softest pair's harmonic-mean modulus
-    (`contact.penalty.contact_modulus`, 399 here): scaled by the mean of all moduli (66733) it was 167
-    times stiffer, a checkerboard at h = 0.01 (7 short gaps per contact, a failed check of the
+    (`contact.penalty.contact_modulus`, 399 here): scaled by the mean of all moduli (66733) it was
+    167 times stiffer, a checkerboard at h = 0.01 (7 short gaps per contact, a failed check of the
     scene, exit 1). At the scene's h = 0.005 its full Uzawa steps cycled (changes of 0.4-6 of
     the largest traction for 300 updates, 32 cut-backs, 132 s) until the loop learned to halve
     its step when the change stops falling (`NewtonOptions.al_stall`): 0 cut-backs, ~15 s."""
@@ -128,7 +128,7 @@ def test_soft_disc_between_stiff_blocks_augmented(tmp_path, h):
     assert m["solver"]["cutbacks"] == 0
     if h == 0.005:  # the full steps cycle there: halved (2-4 times seen)
         assert m["solver"]["uzawa_halvings"] > 0
-    # the default hybrid projection's eps_n = CONSISTENT_EPS0 h / E_c
+    # the default hybrid projection's eps_n = TUNING.consistent_eps0 h / E_c
     assert m["solver"]["multiplier_mass"] == "hybrid"
     assert m["solver"]["penalty"]["eps_n"] == pytest.approx(1.0 * h / (2 * 200 * 1e5 / (1e5 + 200)))
 
@@ -136,8 +136,8 @@ def test_soft_disc_between_stiff_blocks_augmented(tmp_path, h):
 def test_contact_modulus():
     from types import SimpleNamespace as NS
 
-    from dolfinx_forms.fem.laws import LinearElastic
     from dolfinx_forms.contact.penalty import contact_modulus
+    from dolfinx_forms.fem.laws import LinearElastic
 
     bodies = [NS(tag=1), NS(tag=2), NS(tag=3)]
     laws = {1: LinearElastic(1e4, 0.3), 2: LinearElastic(1e4, 0.3), 3: LinearElastic(1e2, 0.3)}

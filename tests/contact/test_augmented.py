@@ -141,9 +141,9 @@ def test_traction_at_nodes_zero_mean_gap():
     pressure is coarser at the contact edge than the default point-wise traction's."""
     from mpi4py import MPI
 
+    from dolfinx_forms.fem.boundary import Dirichlet
     from dolfinx_forms.solvers.checks import penetration
     from dolfinx_forms.solvers.problem import ContactProblem
-    from dolfinx_forms.fem.boundary import Dirichlet
     from meshes.hertz import hertz_scene
 
     scene = hertz_scene(MPI.COMM_SELF, R=10.0, width=20.0, depth=10.0, h=0.1, zone=1.6)
@@ -175,9 +175,9 @@ def _cut_hertz_force(al_first, al_eta, fresh_border=False):
     Newton. fresh_border: the force control's border solved every iteration (no reuse)."""
     from mpi4py import MPI
 
+    from dolfinx_forms.fem.boundary import Dirichlet
     from dolfinx_forms.solvers import protocol
     from dolfinx_forms.solvers.problem import ContactProblem
-    from dolfinx_forms.fem.boundary import Dirichlet
     from meshes.cut import hertz_cut_scene
 
     sc = hertz_cut_scene(MPI.COMM_SELF, R=10.0, width=20.0, depth=10.0, h=0.25, zone=1.6)
@@ -269,11 +269,11 @@ def test_consistent_projection_returns_p1_fields():
 def test_hybrid_projection_rows():
     """PairGeometry.hybrid_projection: all points closed, every row consistent (a P1 field comes
     back exactly, as M^-1 int psi v); none closed, every row lumped (the hat-weighted means);
-    in between, the nodes with >= HYBRID_CLOSED_FRACTION of their hat's weight closed take the
-    consistent row and the others the lumped one; frozen rows stay whatever is closed."""
+    in between, the nodes with >= TUNING.hybrid_closed_fraction of their hat's weight closed take
+    the consistent row and the others the lumped one; frozen rows stay whatever is closed."""
     from mpi4py import MPI
 
-    from dolfinx_forms.geometry.pairs import HYBRID_CLOSED_FRACTION
+    from dolfinx_forms.defaults import TUNING
     from dolfinx_forms.solvers.problem import ContactProblem
     from meshes.hertz import hertz_scene
 
@@ -299,7 +299,7 @@ def test_hybrid_projection_rows():
     idx = np.maximum(g.mult_nodes, 0).ravel()
     W = np.bincount(idx, psi.ravel(), g.num_nodes)
     Wc = np.bincount(idx, (psi * closed[:, None]).ravel(), g.num_nodes)
-    rows = (Wc >= HYBRID_CLOSED_FRACTION * W - 1e-12 * W) & (W > 0)
+    rows = (Wc >= TUNING.hybrid_closed_fraction * W - 1e-12 * W) & (W > 0)
     assert 0 < rows.sum() < (W > 0).sum()
     assert np.array_equal(g.hybrid_rows, rows)
     assert np.allclose(out[~rows & (W > 0)], lumped[~rows & (W > 0)], rtol=0, atol=1e-14)
@@ -354,8 +354,8 @@ def _cut_mindlin(direct):
     direct: the loop at the final eps_t from the start (no continuation)."""
     from mpi4py import MPI
 
-    from dolfinx_forms.solvers.problem import ContactProblem
     from dolfinx_forms.fem.boundary import Dirichlet
+    from dolfinx_forms.solvers.problem import ContactProblem
     from dolfinx_forms.solvers.protocol import friction_on, reach_force
     from meshes.cut import hertz_cut_scene
 
@@ -379,16 +379,16 @@ def _cut_mindlin(direct):
 
 def test_tangential_continuation_reaches_the_final_fixed_point():
     """With friction each step's loop nearly converges (al_switch) at eps_t_start = 1.5 h/E,
-    then goes on at eps_t = 1.0 h/E (solver.CONSISTENT_EPS0_T): its answer is the loop's at
+    then goes on at eps_t = 1.0 h/E (defaults.TUNING.consistent_eps0_t): its answer is the loop's at
     1.0 h/E alone (which converges at this coarse h; at a/20 from the committed tractions it
     can cycle), to the loop's tolerance (1e-7 of the largest traction; 2e-8 seen)."""
-    from dolfinx_forms.solvers.problem import CONSISTENT_EPS0_T, POINTWISE_EPS0_T
+    from dolfinx_forms.defaults import TUNING
 
     runs = [_cut_mindlin(direct) for direct in (False, True)]
     cs = runs[0].contact
     h_over_E = 0.1 / 1e4
-    assert np.isclose(cs.eps_t_start, POINTWISE_EPS0_T * h_over_E, rtol=1e-12)
-    assert np.isclose(cs.eps_t_final, CONSISTENT_EPS0_T * h_over_E, rtol=1e-12)
+    assert np.isclose(cs.eps_t_start, TUNING.pointwise_eps0_t * h_over_E, rtol=1e-12)
+    assert np.isclose(cs.eps_t_final, TUNING.consistent_eps0_t * h_over_E, rtol=1e-12)
     assert cs.eps_t == cs.eps_t_final  # the last solve's, which commit read
     assert runs[0].eps_t == cs.eps_t_final  # what metrics.json reports
     t = [

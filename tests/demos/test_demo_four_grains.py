@@ -66,7 +66,7 @@ def test_coarse_run_writes_the_contract(tmp_path):
     assert np.isclose(pf["bottom"], pf["top"], rtol=1e-8)
     assert all(0 <= v <= 1 for v in r["stick_fraction"].values())
     # --linear-solver reaches the MPM's problem (it was accepted and ignored): the default
-    # factorises (its contact block is too large to condense, linear.CONDENSED_COST), the
+    # factorises (its contact block is too large to condense, defaults.TUNING.condensed_cost), the
     # condensed solver gives the same plate forces
     assert m["solver"]["linear_solver"] == "factorised"
     out2 = tmp_path / "fg_condensed"

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from dolfinx_forms.solvers.problem import ContactProblem
 from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.solvers.problem import ContactProblem
 from meshes.cut import hertz_cut_scene
 from meshes.hertz import hertz_scene
 

@@ -9,11 +9,11 @@ from dolfinx import fem, mesh as dmesh
 from mpi4py import MPI
 
 from dolfinx_forms import Box
+from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.fem.laws import LinearElastic, NeoHookean, OrthotropicElastic
 from dolfinx_forms.mesh.scene import Body, Scene, tag_boundaries
-from dolfinx_forms.solvers.problem import ContactProblem
-from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.solvers.newton import NewtonOptions
+from dolfinx_forms.solvers.problem import ContactProblem
 
 E, NU = 1000.0, 0.3
 W, H, A = 2.0, 1.0, 0.25  # block [-W/2, W/2] x [0, H], punch half-width A

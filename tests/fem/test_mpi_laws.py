@@ -8,10 +8,10 @@ import pytest
 from mpi4py import MPI
 from test_laws import E, H, NU, block_scene, cut_block_scene
 
-from dolfinx_forms.fem.laws import NeoHookean, OrthotropicElastic
-from dolfinx_forms.solvers.problem import ContactProblem
 from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.fem.laws import NeoHookean, OrthotropicElastic
 from dolfinx_forms.solvers.newton import NewtonOptions
+from dolfinx_forms.solvers.problem import ContactProblem
 
 SCENES = {  # name -> (scene on a communicator, the clamped boundary)
     "fitted": (lambda comm: block_scene(8, comm=comm), "bottom"),

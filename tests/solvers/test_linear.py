@@ -6,14 +6,17 @@ one), both paths.
 Both solve J du = -R exactly (direct solvers): the iterates, hence the converged states, agree
 to round-off amplified by the conditioning, far below the Newton tolerance (1e-10 of R)."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 from mpi4py import MPI
 
+from dolfinx_forms import defaults
+from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.fem.laws import NeoHookean
 from dolfinx_forms.solvers import linear, protocol
 from dolfinx_forms.solvers.problem import ContactProblem
-from dolfinx_forms.fem.boundary import Dirichlet
 
 E, NU, R, P = 1.0e4, 0.3, 10.0, 430.0
 pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial: MUMPS Schur")
@@ -147,8 +150,9 @@ def test_auto_factorises_a_large_contact_block(monkeypatch):
     explicit "condensed" still condenses."""
     pb = mindlin(scene("cut"), "auto")
     m, n = len(linear.contact_dofs(pb)), pb.num_dofs
-    assert m**3 <= linear.CONDENSED_COST * n**1.5  # this scene: condensed by default
-    monkeypatch.setattr(linear, "CONDENSED_COST", 0.0)
+    assert m**3 <= defaults.TUNING.condensed_cost * n**1.5  # this scene: condensed by default
+    never = dataclasses.replace(defaults.TUNING, condensed_cost=0.0)
+    monkeypatch.setattr(defaults, "TUNING", never)
     assert linear.choose(pb, "auto").name == "factorised"
     assert linear.choose(pb, "condensed").name == "condensed"
 

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from dolfinx_forms.solvers import protocol
-from dolfinx_forms.solvers.problem import ContactProblem
-from dolfinx_forms.solvers.newton import ContactSolverError
 from dolfinx_forms.fem.boundary import Dirichlet, Traction
+from dolfinx_forms.solvers import protocol
+from dolfinx_forms.solvers.newton import ContactSolverError
+from dolfinx_forms.solvers.problem import ContactProblem
 
 E, NU, N = 1.0, 0.3, 3
 
