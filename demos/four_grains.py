@@ -28,7 +28,7 @@ from dolfinx_forms.app.demo import Run
 from dolfinx_forms.app.mpm_run import Steps, binned_mean, plot_force_chains
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody, equilibrium_error
 from meshes.four_grains import check_contact_zones, four_grains, grain_outlines
-from meshes.mpm import plate_face_conditions
+from meshes.mpm import plate_face_conditions, plate_forces
 
 # fmt: off
 OPTIONS = [  # option, kind, default[, help]
@@ -191,15 +191,12 @@ def main(argv=None):
         steps = Steps(run, sim, COLUMNS, args.steps, series_every=1)
         for _ in range(args.steps):
             rec = steps.step()
-            f, act = rec["body_forces"], active(rec)
+            act = active(rec)
             steps.rows.append(
                 dict(
                     step=rec["step"],
                     displacement=rec["step"] * args.displacement,
-                    force_left=-f["plate_left"][0],
-                    force_right=f["plate_right"][0],
-                    force_bottom=-f["plate_bottom"][1],
-                    force_top=f["plate_top"][1],
+                    **plate_forces(rec),
                     active_contacts=len(act),
                     min_stick_fraction=min(q["stick_fraction"] for q in act),
                     newton_iterations=rec["newton_iterations"],

@@ -26,7 +26,7 @@ from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
 from dolfinx_forms.app.mpm_run import Steps, plot_force_chains
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody, equilibrium_error
-from meshes.mpm import nine_discs, plate_face_conditions
+from meshes.mpm import nine_discs, plate_face_conditions, plate_forces
 
 # fmt: off
 OPTIONS = [  # option, kind, default[, help]
@@ -173,15 +173,11 @@ def main(argv=None):
         steps = Steps(run, sim, COLUMNS, args.steps, series_every=1)
         for _ in range(args.steps):
             rec = steps.step()
-            f = rec["body_forces"]
             steps.rows.append(
                 dict(
                     step=rec["step"],
                     displacement=rec["step"] * args.displacement,
-                    force_left=-f["plate_left"][0],
-                    force_right=f["plate_right"][0],
-                    force_bottom=-f["plate_bottom"][1],
-                    force_top=f["plate_top"][1],
+                    **plate_forces(rec),
                     newton_iterations=rec["newton_iterations"],
                     wall_s=rec["wall_s"],
                 )

@@ -1,22 +1,8 @@
 """Structured-grid (cut-cell) scenes: the counterparts of the body-fitted gmsh scenes.
 
-Geometry (dolfinx_forms/mesh/cut_scene.py): a tensor-product background grid of quadrilaterals (x
-lines `xlines`, y lines `ylines`, strictly increasing, uniform or graded, see :func:`graded_lines`).
-Body b is
-  window_b ∩ {cut_shape_b < 0},
-window_b = [x0, x1] x [y0, y1] with all four bounds grid lines (its grid-aligned sides carry
-the Dirichlet conditions and tractions), cut_shape_b a dolfinx_forms shape (< 0 inside) whose
-zero contour alone cuts cells (so no kink of the level set lies inside a cell at the window
-corners). The exact shape for contact is Body.shape = Intersection([cut_shape, Box(window)]).
-Active cells of body b: the grid cells inside its window with min(phi) < 0 over their four
-vertices (phi = cut_shape at the vertices); a cell is "interior" (kind 0) if max(phi) <= 0, else
-"cut" (kind 1). All bodies' active cells form ONE quadrilateral DOLFINx mesh as a disjoint
-union: each body has its own vertices (coincident, distinct vertices where bodies overlap
-the same grid region). The body tag and kind of every cell come from the construction (carried
-through the distribution by the topology's original cell index), not from the shapes.
-Ghost facets (tag 1): interior facets (two cells of one body) with at least one cut cell.
-Boundaries: named facet tags as in the gmsh scenes; names on a cut (non grid-aligned)
-boundary are kept in Scene.boundaries but mark no facet.
+The geometry (bodies as level-set windows on one tensor-product grid, interior and cut cells,
+ghost facets, boundaries) is dolfinx_forms/mesh/cut_scene.py's `cut_scene`; these are the
+verification scenes built with it.
 Generators (same body names/tags, boundary names, pairs and contact boxes as meshes/*.py):
   hertz_cut_scene       block window [-W, W] x [-depth, 0] (no cut cell), cylinder window
                         [-R, R] x [0, Ry] cut by Circle((0, R), R) (Ry = R, the default) or
@@ -25,7 +11,7 @@ Generators (same body names/tags, boundary names, pairs and contact boxes as mes
   patch_cut_scene       [0, width] x [0, height] split at y = interface (not a grid line)
   two_blocks_cut_scene  the two blocks, interface y = height mid-cell (ny odd)
   incline_cut_scene     the square cut by y = slope x + intercept
-Run: /usr/bin/python3 -m meshes.cut [--scene hertz] [--h 0.05] [--n 5]   (from the repository root)
+Run: /usr/bin/python3 -m meshes.cut [--scene hertz] [--h 0.05] [--n 5]  (from the repository root)
 """
 
 from __future__ import annotations

@@ -157,3 +157,15 @@ def plate_face_conditions(faces, displacement):
         )
         for axis, c in faces.values()
     ]
+
+
+def plate_forces(record):
+    """The four plates' compressive forces (positive inward) of an ImplicitMPM step record:
+    the steps.csv columns force_left, force_right, force_bottom, force_top."""
+    f = record["body_forces"]
+    return dict(
+        force_left=-f["plate_left"][0],
+        force_right=f["plate_right"][0],
+        force_bottom=-f["plate_bottom"][1],
+        force_top=f["plate_top"][1],
+    )
