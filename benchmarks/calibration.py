@@ -62,7 +62,7 @@ def measure(argv):
         p_l2=r["pressure_rel_l2_error"],
         p_l2_circle=r["pressure_rel_l2_error_circle"],
         newton=sum(s["newton_iterations"]),
-        uzawa=s.get("augmentations"),
+        uzawa=sum(s.get("augmentations") or [0]),  # Uzawa updates over the stages
         dofs=run.metrics["mesh"]["num_dofs"],
     )
     if "stick_half_width_circle" in a:

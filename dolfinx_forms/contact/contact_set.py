@@ -59,7 +59,7 @@ Its multipliers are left unclipped too.
 import numpy as np
 
 from dolfinx_forms import _cpp
-from dolfinx_forms.geometry.obstacles import contact_resultants
+from dolfinx_forms.contact.resultants import traction_resultant
 from dolfinx_forms.geometry.pairs import pair_geometry
 
 STATE_NAMES = {0: "open", 1: "stick", 2: "slip"}
@@ -196,22 +196,14 @@ class ContactSet:
 
     def obstacle_resultants(self):
         """{obstacle name: (force (2,), moment)} exerted by the bodies on each obstacle in the
-        last accepted state (see `obstacles.contact_resultants`); zeros without contact."""
+        last accepted state (`resultants.traction_resultant`); zeros without contact."""
         out = {ob.name: (np.zeros(2), 0.0) for ob in self.obstacles}
         for k, g in enumerate(self.pairs):
             s = self.committed[k]
             if g.obstacle is None or s is None:
                 continue
-            F, M = contact_resultants(
-                g.obstacle,
-                g.points,
-                g.weights,
-                g.normals,
-                g.tangents,
-                s["tau_n"],
-                s["tau_t"],
-                g.p_j,
-            )
+            # on the obstacle (side j), its moment about the obstacle's current centre
+            F, M = traction_resultant(g, s, "j", g.p_j, g.obstacle.current_center)
             F0, M0 = out[g.obstacle.name]
             out[g.obstacle.name] = (F0 + F, M0 + M)
         return out

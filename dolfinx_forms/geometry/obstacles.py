@@ -141,13 +141,3 @@ class RigidObstacle:
             r["points"] = self.push_forward(r["points"])
             return r
         return _cpp.closest_point_projection(phi_on_grid, np.ascontiguousarray(points))
-
-
-def contact_resultants(obstacle, points, weights, normals, tangents, tau_n, tau_t, p_j):
-    """Force (2,) and moment (about the obstacle's current centre) that the deformable body
-    exerts on the obstacle through one pair's contact points: the traction on side j is
-    -(tau_n n + tau_t t) per unit length (n from the body to the obstacle, compression
-    tau_n < 0 pushes the obstacle away)."""
-    t = -(tau_n[:, None] * normals + tau_t[:, None] * tangents) * weights[:, None]
-    r = p_j - obstacle.current_center
-    return t.sum(axis=0), float(np.sum(r[:, 0] * t[:, 1] - r[:, 1] * t[:, 0]))

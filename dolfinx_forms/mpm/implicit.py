@@ -42,6 +42,7 @@ from mpi4py import MPI
 from dolfinx_forms import _cpp
 from dolfinx_forms.mpm import material_points as mp
 from dolfinx_forms.common import allreduce_array
+from dolfinx_forms.contact.resultants import traction_resultant
 from dolfinx_forms.fem.boundary import Load
 from dolfinx_forms.fem.cut import grid_cells
 from dolfinx_forms.fem.laws import as_law, law_key
@@ -422,11 +423,11 @@ class ImplicitMPM:
             order = np.argsort(g.points[:, 0])
             xl, xr = zone_ends(g.points[order, 0], active[order], s["g_n"][order])
             wa = w[active]
-            f = -(s["tau_n"][:, None] * g.normals + s["tau_t"][:, None] * g.tangents) * w[:, None]
+            f = traction_resultant(g, s, "j")[0]  # on body j (the obstacle) from body i
             pairs.append(
                 dict(
-                    fx=float(f[:, 0].sum()),  # resultant on body j (the obstacle) from body i
-                    fy=float(f[:, 1].sum()),
+                    fx=float(f[0]),
+                    fy=float(f[1]),
                     body_i=keys[k][0],
                     body_j=keys[k][1],
                     x=float(np.average(g.points[active, 0], weights=wa)) if active.any() else 0.0,
@@ -452,21 +453,12 @@ class ImplicitMPM:
         forces = {b.name: np.zeros(3) for b in self.bodies}
         for k, g in enumerate(cs.pairs):
             s = cs.committed[k]
-            f = (s["tau_n"][:, None] * g.normals + s["tau_t"][:, None] * g.tangents) * g.weights[
-                :, None
-            ]
-            for sign, name, p in ((1.0, keys[k][0], g.p_i), (-1.0, keys[k][1], g.p_j)):
+            for side, name, p in (("i", keys[k][0], g.p_i), ("j", keys[k][1], g.p_j)):
                 if name in forces:
                     b = next(b for b in self.bodies if b.name == name)
                     c = np.average(self.points[b.tag].x, axis=0, weights=self.points[b.tag].vol)
-                    r = p - c
-                    forces[name] += sign * np.array(
-                        [
-                            f[:, 0].sum(),
-                            f[:, 1].sum(),
-                            np.sum(r[:, 0] * f[:, 1] - r[:, 1] * f[:, 0]),
-                        ]
-                    )
+                    F, M = traction_resultant(g, s, side, p, c)
+                    forces[name] += np.array([F[0], F[1], M])
         body_forces = {
             n: allreduce_array(self.comm, v, MPI.SUM).tolist() for n, v in forces.items()
         }
