@@ -15,7 +15,6 @@ Run: /usr/bin/python3 demos/contact_geometry.py [--R 10 --gap 0.02 --h 0.05 --ou
 Results and discussion: docs/demos/contact_geometry.md
 """
 
-import csv
 from types import SimpleNamespace
 
 import numpy as np
@@ -23,6 +22,7 @@ import numpy as np
 import dolfinx_forms as df
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
+from dolfinx_forms.io.output import write_columns
 from dolfinx_forms.solvers.newton import ContactSolverError
 
 OPTIONS = [  # option, kind, default[, help]
@@ -88,14 +88,12 @@ def files(run, folder):
 
     d, sc = run.data, run.scene
     s, x = d["s"], d["s"]["points"]
-    with open(folder / "contact_points.csv", "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["x", "y", "nx", "ny", "weight", "pi_x", "pi_y", "pj_x", "pj_y", "g_n0"])
-        w.writerows(
-            np.c_[
-                x, s["normals"], s["weights"], d["pi"]["points"], d["pj"]["points"], d["g_n0"]
-            ].tolist()
-        )
+    pi, pj, n = d["pi"]["points"], d["pj"]["points"], s["normals"]
+    write_columns(
+        folder / "contact_points.csv", x=x[:, 0], y=x[:, 1], nx=n[:, 0], ny=n[:, 1],
+        weight=s["weights"], pi_x=pi[:, 0], pi_y=pi[:, 1], pj_x=pj[:, 0], pj_y=pj[:, 1],
+        g_n0=d["g_n0"],
+    )  # fmt: skip
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
     X = sc.grid.nodes().reshape(sc.grid.shape + (2,))
     ax[0].contour(X[..., 0], X[..., 1], sc.block.values, [0], colors="k")

@@ -15,11 +15,11 @@ set and extended step displacement). The series store raw little-endian float64 
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
 
+from dolfinx_forms.io.output import write_table
 from dolfinx_forms.solvers.newton import ContactSolverError
 
 CONTACT_COLUMNS = [
@@ -34,14 +34,6 @@ CONTACT_COLUMNS = [
     "stick_fraction",
 ]
 BODY_COLUMNS = ["step", "body", "fx", "fy", "moment", "area_levelset", "volume_points"]
-
-
-def write_csv(path, columns, rows):
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(columns)
-        for r in rows:
-            w.writerow([r[c] for c in columns])
 
 
 class Series:
@@ -217,9 +209,9 @@ class Steps:
             for r in self.records
             for b in self.sim.bodies
         ]
-        write_csv(folder / "steps.csv", self.columns, self.rows)
-        write_csv(folder / "contacts.csv", CONTACT_COLUMNS, contacts)
-        write_csv(folder / "bodies.csv", BODY_COLUMNS, bodies)
+        write_table(folder / "steps.csv", self.columns, self.rows)
+        write_table(folder / "contacts.csv", CONTACT_COLUMNS, contacts)
+        write_table(folder / "bodies.csv", BODY_COLUMNS, bodies)
         for series in list(self.points_series.values()) + [self.grid_series]:
             series.write(folder)
 

@@ -25,34 +25,34 @@ def gather_points(problem):
     return {k: v[order] for k, v in pts.items()}
 
 
-def write_tractions(folder, pts):
-    with open(Path(folder) / "tractions.csv", "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(TRACTION_COLUMNS)
-        for k in range(len(pts["x"])):
-            w.writerow(
-                [
-                    f"{pts['x'][k]:.12e}",
-                    f"{pts['y'][k]:.12e}",
-                    f"{pts['p_n'][k]:.12e}",
-                    f"{pts['p_t'][k]:.12e}",
-                    f"{pts['gap_n'][k]:.12e}",
-                    f"{pts['slip'][k]:.12e}",
-                    STATE_NAMES[int(pts["state"][k])],
+def write_table(path, columns, rows, float_format=None):
+    """The one CSV writer of every table a run writes: a header of `columns`, then one line
+    per row (a sequence in column order, or a dict by column name); floats in
+    `float_format` (e.g. ".12e"), else as Python prints them."""
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(columns)
+        for row in rows:
+            values = [row[c] for c in columns] if isinstance(row, dict) else row
+            if float_format is not None:
+                values = [
+                    format(v, float_format) if isinstance(v, (float, np.floating)) else v
+                    for v in values
                 ]
-            )
+            w.writerow(values)
+
+
+def write_tractions(folder, pts):
+    """tractions.csv: the contact points (TRACTION_COLUMNS), their state by name."""
+    state = [STATE_NAMES[int(s)] for s in pts["state"]]
+    columns = [pts[k] for k in ("x", "y", "p_n", "p_t", "gap_n", "slip")]
+    rows = zip(*columns, state)
+    write_table(Path(folder) / "tractions.csv", TRACTION_COLUMNS, rows, ".12e")
 
 
 def write_columns(path, **columns):
-    """A CSV file of equally long columns {name: values}: a header line, then %.12e values."""
-    np.savetxt(
-        path,
-        np.column_stack(list(columns.values())),
-        delimiter=",",
-        fmt="%.12e",
-        header=",".join(columns),
-        comments="",
-    )
+    """A CSV file of equally long columns {name: values} (write_table, %.12e values)."""
+    write_table(path, list(columns), zip(*columns.values()), ".12e")
 
 
 def write_fields(folder, problem, name="solution"):
