@@ -251,7 +251,7 @@ def write(
             write_fields(folder, run.problem)
         if run.rank0:
             if tractions and run.pts is not None:
-                write_tractions(folder, run.pts)
+                write_tractions(folder, run.pts, frictionless=run.problem.contact.mu == 0)
             if plot is not None and run.pts is not None:
                 plot(run, folder / "tractions.png")
             if files is not None:

@@ -7,7 +7,6 @@ import numpy as np
 
 from dolfinx_forms.contact.contact_set import STATE_NAMES
 from dolfinx_forms.io import plot_worker
-from dolfinx_forms.io.results import write_metrics
 
 TRACTION_COLUMNS = ("x", "y", "p_n", "p_t", "gap_n", "slip", "state")
 
@@ -42,9 +41,11 @@ def write_table(path, columns, rows, float_format=None):
             w.writerow(values)
 
 
-def write_tractions(folder, pts):
-    """tractions.csv: the contact points (TRACTION_COLUMNS), their state by name."""
-    state = [STATE_NAMES[int(s)] for s in pts["state"]]
+def write_tractions(folder, pts, frictionless=False):
+    """tractions.csv: the contact points (TRACTION_COLUMNS), their state by name: open, stick
+    or slip; without friction an active point is "active" (nothing sticks or slips)."""
+    names = {**STATE_NAMES, **({1: "active", 2: "active"} if frictionless else {})}
+    state = [names[int(s)] for s in pts["state"]]
     columns = [pts[k] for k in ("x", "y", "p_n", "p_t", "gap_n", "slip")]
     rows = zip(*columns, state)
     write_table(Path(folder) / "tractions.csv", TRACTION_COLUMNS, rows, ".12e")
@@ -106,16 +107,6 @@ def stop_plot_worker():
     worker, _worker = _worker, None
     if worker is not None:
         worker.close()
-
-
-def finish(folder, metrics, problem, pts, plot=None):
-    """Everything beside metrics.json, then metrics.json (rank 0 writes the small files)."""
-    write_fields(folder, problem)
-    if problem.comm.rank == 0:
-        write_tractions(folder, pts)
-        if plot is not None:
-            plot(Path(folder) / "tractions.png")
-        write_metrics(folder, metrics)
 
 
 def window_average(x, p, width):

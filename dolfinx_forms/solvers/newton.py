@@ -334,11 +334,14 @@ def load_steps(problem, num_steps=1, lam_end=1.0, label="step", initial_guess=No
             problem.steps[-1].augmentations = augmentations
             nst = problem.comm.allreduce(problem.contact.state_counts(), MPI.SUM)
             aug = f" in {augmentations + 1} augmented solves" if problem.contact.augmented else ""
+            states = (
+                f"open/active {nst[0]}/{nst[1] + nst[2]}"  # frictionless: no stick, no slip
+                if problem.contact.mu == 0
+                else f"open/stick/slip {nst[0]}/{nst[1]}/{nst[2]}"
+            )
             problem.log(
                 f"{label} lam={target:.4f}: {len(residuals) - 1 - augmentations} Newton "
-                f"iterations{aug}, "
-                f"|R| {residuals[0]:.2e} -> {residuals[-1]:.2e}, "
-                f"open/stick/slip {nst[0]}/{nst[1]}/{nst[2]} "
+                f"iterations{aug}, |R| {residuals[0]:.2e} -> {residuals[-1]:.2e}, {states} "
                 f"({time.perf_counter() - t0:.2f} s)"
             )
             continue

@@ -132,7 +132,7 @@ def test_tractions_csv_contract(hertz):
     data = np.genfromtxt(
         hertz / "tractions.csv", delimiter=",", names=True, dtype=None, encoding=None
     )
-    assert set(data["state"]) <= {"open", "stick", "slip"}
+    assert set(data["state"]) <= {"open", "active", "stick", "slip"}
     active = data["state"] != "open"
     # half-width from the active points, as in metrics.json
     m = metrics(hertz)
