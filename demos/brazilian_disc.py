@@ -17,10 +17,14 @@ Run: /usr/bin/python3 demos/brazilian_disc.py [--steps 50] [--h 0.2]
 Results and discussion: docs/demos/brazilian_disc.md
 """
 
+import importlib.util
 import sys
 
 import numpy as np
 
+if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNotFoundError
+    sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
+             "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
 from dolfinx_forms.app.mpm_run import Steps, binned_mean

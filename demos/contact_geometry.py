@@ -15,10 +15,15 @@ Run: /usr/bin/python3 demos/contact_geometry.py [--R 10 --gap 0.02 --h 0.05 --ou
 Results and discussion: docs/demos/contact_geometry.md
 """
 
+import importlib.util
+import sys
 from types import SimpleNamespace
 
 import numpy as np
 
+if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNotFoundError
+    sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
+             "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
 import dolfinx_forms as df
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run

@@ -26,11 +26,15 @@ Run: /usr/bin/python3 demos/convergence_study.py [--discretization {conforming,c
 Results and discussion: docs/demos/convergence_study.md
 """
 
+import importlib.util
 import signal
 import sys
 import tempfile
 from pathlib import Path
 
+if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNotFoundError
+    sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
+             "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
 from dolfinx_forms.app import cli, study
 from dolfinx_forms.app.study import (
     CASE,

@@ -20,8 +20,12 @@ Run: /usr/bin/python3 demos/hertz.py [--discretization cut] [--mu 0.3 --tangenti
 Results and discussion: docs/demos/hertz.md
 """
 
+import importlib.util
 import sys
 
+if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNotFoundError
+    sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
+             "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
 from dolfinx_forms.analysis import analytic, compare
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run

@@ -23,10 +23,14 @@ Run: /usr/bin/python3 demos/inclined_interface.py [--mu 0.21] [--discretization 
 Results and discussion: docs/demos/inclined_interface.md
 """
 
+import importlib.util
 import sys
 
 import numpy as np
 
+if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNotFoundError
+    sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
+             "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
 from dolfinx_forms.analysis import analytic, compare, post
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run

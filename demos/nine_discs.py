@@ -18,10 +18,14 @@ Run: /usr/bin/python3 demos/nine_discs.py [--h 0.1] [--mu 0.5]
 Results and discussion: docs/demos/nine_discs.md
 """
 
+import importlib.util
 import sys
 
 import numpy as np
 
+if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNotFoundError
+    sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
+             "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
 from dolfinx_forms.app.mpm_run import Steps, plot_force_chains

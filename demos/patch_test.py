@@ -17,10 +17,14 @@ Run: /usr/bin/python3 demos/patch_test.py [--discretization cut] [--h 0.125]
 Results and discussion: docs/demos/patch_test.md
 """
 
+import importlib.util
 import sys
 
 import numpy as np
 
+if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNotFoundError
+    sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
+             "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
 from dolfinx_forms.analysis import compare
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run

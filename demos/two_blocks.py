@@ -24,11 +24,15 @@ Run: /usr/bin/python3 demos/two_blocks.py [--mu 0.5] [--discretization cut] [--h
 Results and discussion: docs/demos/two_blocks.md
 """
 
+import importlib.util
 import sys
 
 import numpy as np
 import ufl
 
+if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNotFoundError
+    sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
+             "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
 from dolfinx_forms.analysis import compare, post
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
