@@ -49,6 +49,7 @@ from dolfinx_forms.app.cli import DemoParser, bounded
 from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.fem.laws import LinearElastic, OrthotropicElastic
 from dolfinx_forms.io.output import gather_points, window_average
+from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem, zone_ends
 from dolfinx_forms.solvers.protocol import ramp
 from meshes.cut import hertz_cut_scene
@@ -106,11 +107,9 @@ def run_path(
     problem = ContactProblem(
         sc,
         {b.tag: law for b in sc.bodies},
-        mu=0.0,
-        eps0=eps0,
-        band=band,
         dirichlet=[Dirichlet("block_bottom", None, 0.0), Dirichlet("cylinder_top", 0, 0.0), top_y],
         log=lambda *a, **k: None,
+        **options(mu=0.0, eps0=eps0, band=band),
     )
     ramp(problem, top_y, -delta, steps=steps)
     reaction = problem.reaction("block_bottom")

@@ -96,6 +96,7 @@ def _reference_timed(discretization, divisor, timer):
     from petsc4py import PETSc
 
     from dolfinx_forms.fem.boundary import Dirichlet
+    from dolfinx_forms.solvers.options import options
     from dolfinx_forms.solvers.problem import ContactProblem
 
     hertz = hertz_demo()
@@ -104,7 +105,7 @@ def _reference_timed(discretization, divisor, timer):
     sc = hertz.scene(MPI.COMM_WORLD, SimpleNamespace(**p))
     bcs = [Dirichlet("block_bottom", None, 0.0), Dirichlet("cylinder_top", None, -0.01)]
     laws = {b.tag: (p["E"], p["nu"]) for b in sc.bodies}
-    pb = ContactProblem(sc, laws, dirichlet=bcs, timer=timer, linear_solver="factorised")
+    pb = ContactProblem(sc, laws, dirichlet=bcs, timer=timer, **options(linear_solver="factorised"))
     t0 = time.perf_counter()
     K = pb.K.copy()
     K.zeroRows(pb.bc_global, diag=1.0)

@@ -52,6 +52,7 @@ from dolfinx_forms.analysis import analytic
 from benchmarks.common import git_head, write_atomic
 from dolfinx_forms.app.cli import DemoParser, bounded
 from dolfinx_forms.solvers.newton import ContactSolverError
+from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 from meshes.cut import patch_cut_scene
 from meshes.patch import patch_dirichlet
@@ -140,12 +141,9 @@ def patch_problem(n, interface, gamma, eps0=EPS0, comm=MPI.COMM_WORLD):
     problem = ContactProblem(
         scene,
         {b.tag: (E, NU) for b in scene.bodies},
-        mu=0.0,
-        eps0=eps0,
-        band=0.5 * HEIGHT / n,
-        ghost_penalty=gamma,
         dirichlet=patch_dirichlet(D, HEIGHT),
         log=lambda *a, **k: None,
+        **options(mu=0.0, eps0=eps0, band=0.5 * HEIGHT / n, ghost_penalty=gamma),
     )
     return scene, problem
 

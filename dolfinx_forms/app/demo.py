@@ -136,14 +136,18 @@ class Run:
         """A ContactProblem on the scene, timed by the run's timer, with the options that the
         parameters name: E, nu (every body linear elastic), mu, eps0, degree, ghost_penalty,
         grid_refine, gauss (num_gauss), petsc (petsc_options). Keywords override them."""
+        from dolfinx_forms.solvers.options import options
         from dolfinx_forms.solvers.problem import ContactProblem
 
-        p, opts = self.params, {"timer": self.timer, "dirichlet": dirichlet}
-        if "E" in p:
-            opts["materials"] = {b.tag: (p["E"], p["nu"]) for b in self.scene.bodies}
-        opts.update(problem_options(p))
-        opts.update(kw)
-        return ContactProblem(self.scene, opts.pop("materials"), **opts)
+        p = self.params
+        materials = kw.pop("materials", None)
+        if materials is None:
+            materials = {b.tag: (p["E"], p["nu"]) for b in self.scene.bodies}
+        direct = {k: kw.pop(k) for k in ("tractions", "loads", "obstacles", "log") if k in kw}
+        grouped = options(**{**problem_options(p), **kw})
+        return ContactProblem(
+            self.scene, materials, dirichlet=dirichlet, timer=self.timer, **direct, **grouped
+        )
 
     def measure(self, reactions=()):
         """After the stages: the reactions at `reactions` (boundary names), the contact points

@@ -121,6 +121,7 @@ def build_problem(spec, scene, timer=None, log=print):
     """(ContactProblem, loads {name: load}, targets {name: declared value or scale})."""
     from dolfinx_forms.fem.boundary import BodyForce, Dirichlet, Traction
     from dolfinx_forms.solvers.newton import NewtonOptions
+    from dolfinx_forms.solvers.options import options
     from dolfinx_forms.solvers.problem import ContactProblem
 
     tags = {b["name"]: i + 1 for i, b in enumerate(spec["bodies"])}
@@ -139,20 +140,22 @@ def build_problem(spec, scene, timer=None, log=print):
     loads.update({t["name"]: ld for t, ld in zip(spec["tractions"], tractions)})
     loads.update({f["name"]: ld for f, ld in zip(spec["body_forces"], forces)})
     s = spec["solver"]
-    options = "mu eps0 band grid_refine num_gauss ghost_penalty quadrature_degree cut_degree"
-    options += " linear_solver enforcement multiplier_mass"
+    named = "mu eps0 band grid_refine num_gauss ghost_penalty quadrature_degree cut_degree"
+    named += " linear_solver enforcement multiplier_mass"
     problem = ContactProblem(
         scene,
         {tags[b["name"]]: make_law(b["law"]) for b in spec["bodies"]},
-        degree=spec["discretization"].get("degree", 1),
         timer=timer,
         log=log,
         dirichlet=[loads[x["name"]] for x in spec["dirichlet"]],
         tractions=tractions,
         loads=forces,
-        newton=NewtonOptions(**s["newton"]),
-        petsc_options=s["petsc"],
-        **{k: s[k] for k in options.split()},
+        **options(
+            **{k: s[k] for k in named.split()},
+            degree=spec["discretization"].get("degree", 1),
+            newton=NewtonOptions(**s["newton"]),
+            petsc_options=s["petsc"],
+        ),
     )
     targets = {x["name"]: x["value"] for x in spec["dirichlet"]}
     targets.update({x["name"]: x["scale"] for x in spec["tractions"] + spec["body_forces"]})

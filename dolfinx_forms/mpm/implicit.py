@@ -46,6 +46,7 @@ from dolfinx_forms.contact.resultants import traction_resultant
 from dolfinx_forms.fem.boundary import Load
 from dolfinx_forms.fem.cut import grid_cells
 from dolfinx_forms.fem.laws import as_law, law_key
+from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem, zone_ends
 
 
@@ -131,6 +132,7 @@ class ImplicitMPM:
                 "carries point-wise slip from step to step, and its contacts span about one "
                 "grid cell, too few for the augmented Lagrangian's P1 multipliers)"
             )
+        options(**problem_kw)  # an unknown option fails here, not at the first step
         self.problem_kw = problem_kw
         self.points = None  # {tag: MaterialPoints}, seeded on the first scene
         self.friction = {}  # pair key -> (points (n, 2), elastic tangential gap (n,))
@@ -221,7 +223,7 @@ class ImplicitMPM:
             obstacles=self.obstacles,
             timer=self.timer,
             log=self.log,
-            **kw,
+            **options(**kw),
         )
         if self.points is None:
             self.points = {b.tag: mp.seed(scene, problem.integration, b.tag) for b in self.bodies}

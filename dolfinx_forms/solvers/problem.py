@@ -30,54 +30,23 @@ from dolfinx_forms.fem.laws import as_law
 from dolfinx_forms.geometry.pairs import DEFAULT_MULTIPLIER_MASS, MULTIPLIER_MASSES, TRACTIONS
 from dolfinx_forms.solvers import blas, linear
 from dolfinx_forms.solvers.newton import NewtonOptions, load_steps
+from dolfinx_forms.solvers.options import ContactOptions, FemOptions, SolverOptions
 
 # the tuned factors of the augmented Lagrangian's regularisation and the BLAS threshold are
 # read from dolfinx_forms.defaults.TUNING when a problem is made (their studies: STUDIES there)
 
 
 class ContactProblem:
-    """Bodies of a `dolfinx_forms.mesh.scene.Scene` in frictional contact (penalty, eqs 8-12, 48).
+    """Bodies of a `dolfinx_forms.mesh.scene.Scene` in frictional contact (eqs 8-12, 37, 48).
 
-    materials: {body tag: Law or (E, nu)} (`laws.py`; (E, nu) is `LinearElastic`); mu:
-    friction coefficient (0: frictionless, no friction work); eps0: penalty factor of eq 51,
-    eps_n = eps_t = eps0 h / E_c, E_c the most compliant contact's modulus
-    (`contact.penalty.contact_modulus`: E on equal moduli, 2 E against a rigid obstacle); band:
-    largest
-    initial gap that Gamma_c covers (a length); degree: Lagrange degree (1 or 2; 1 on a cut
-    scene); loads: `BodyForce`/`Load`s; quadrature_degree: see `BulkForms`. A scene with `cut`
-    data (meshes.cut) integrates over the inside part of cut cells (`cut.CutIntegration`,
-    degree `cut_degree`) with ghost penalty `ghost_penalty` (0: none). obstacles: rigid
-    `obstacles.RigidObstacle`s (no dofs) whose step motion is ramped with lam.
-    rigid_mode_stiffness: alpha of a spring alpha E / L^2 on every body's displacement, for
-    bodies held by contact alone (free grains); it changes the answer by ~alpha (0: none).
-    predictor_gap: in the first Newton iteration of a step, open contact points with a gap
-    below it add a closed point's tangent (no force), so bodies whose contacts touch but are
-    not closed yet are held (a length; 0: exact tangent throughout; the answer is unchanged).
-    pair_grid_origin: None, or a point through which every pair's level-set grid passes
-    (`contact.pair_geometry`'s lattice_origin: symmetric scenes stay symmetric).
-    enforcement: "penalty" (the answer depends on eps0) or "augmented" (augmented Lagrangian,
-    Uzawa loop, `contact_set`: eps0 sets only the loop's speed). multipliers: None (a traction
-    per contact point), "P0" or "P1": one traction per multiplier node along Gamma_c, nodes
-    multiplier_length apart (`contact.multiplier_nodes`: a stable pressure at any eps0);
-    default "P1" with "augmented", None with "penalty". multiplier_length: default h body-fitted,
-    1.5 h cut (Hertz at h = a/20, P1: 0.5 h and, on the cut path, 0.75 h give a checkerboard;
-    p(x) 1.9 / 2.3 / 3.1 % body-fitted at 0.75 / 1 / 1.5 h, 3.9 / 3.4 % cut at 1 / 1.5 h, with
-    traction "nodes"). traction: "nodes" (the law on each node's weighted mean gap) or "points"
-    (the law at each point with the multipliers interpolated, `contact_set`; the kernel's eps_n
-    and eps_t are then the tuned factors pointwise_eps0 and pointwise_eps0_t (defaults.TUNING)
-    times h / E_c (eq 51), and
-    eps0 relaxes the Uzawa step by min(1, eps_n / eps));
-    default "points" with "augmented". multiplier_mass (augmented, P1, traction "points"):
-    "hybrid" (default: zero weighted gap on the closed part of every node mostly in contact,
-    the lumped projection at the contact edge), "consistent" (zero weighted mean gap at every
-    node in contact, a coarser pressure) or "lumped" (weighted gaps ~1e-3 h); the first two
-    with eps_n = consistent_eps0 h / E_c and nodes consistent_length h apart by default
-    (defaults.TUNING)
-    (`contact_set`).
-    linear_solver: "auto", "condensed", "factorised" or "iterative" (`linear.py`: a linear bulk
-    on one process is factorised once, with Newton on the Schur complement of the contact dofs;
-    "iterative": CG + GAMG with the rigid-body modes, chosen by "auto" for large body-fitted
-    problems).
+    materials: {body tag: Law or (E, nu)} (`fem.laws`; (E, nu) is `LinearElastic`).
+    dirichlet: `Dirichlet` conditions; tractions: `Traction`s; loads: `BodyForce`/`Load`s.
+    obstacles: rigid `geometry.obstacles.RigidObstacle`s (no dofs) whose step motion is
+    ramped with lam. contact, fem, solver: the grouped options (`solvers.options`:
+    ContactOptions, FemOptions, SolverOptions; `**options(mu=..., degree=...)` sorts flat
+    keywords into them). A scene with `cut` data integrates over the inside part of cut
+    cells (`fem.cut.CutIntegration`) with a ghost penalty. timer: a `io.results.PhaseTimer`
+    (or None); log: where the Newton lines go (rank 0).
     """
 
     def __init__(
@@ -85,181 +54,120 @@ class ContactProblem:
         scene,
         materials,
         *,
-        mu=0.0,
-        eps0=1.0,
-        band=None,
-        degree=1,
         dirichlet=(),
         tractions=(),
         loads=(),
-        newton=None,
-        petsc_options=None,
-        grid_refine=4,
-        num_gauss=2,
-        timer=None,
-        contact_rank=0,
-        ghost_penalty=0.01,
-        quadrature_degree=None,
-        cut_degree=4,
         obstacles=(),
-        rigid_mode_stiffness=0.0,
-        predictor_gap=0.0,
-        pair_grid_origin=None,
-        enforcement="penalty",
-        multipliers="default",
-        multiplier_length=None,
-        traction="default",
-        multiplier_mass=None,
-        linear_solver="auto",
+        contact=None,
+        fem=None,
+        solver=None,
+        timer=None,
         log=print,
     ):
+        c = contact if contact is not None else ContactOptions()
+        fo = fem if fem is not None else FemOptions()
+        so = solver if solver is not None else SolverOptions()
         self.scene, self.mesh = scene, scene.mesh
         self.comm = self.mesh.comm
-        self.newton = newton or NewtonOptions()
+        self.newton = so.newton or NewtonOptions()
         self.timer = timer
         self.log = log if self.comm.rank == 0 else (lambda *a, **k: None)
-        self.predictor_gap = float(predictor_gap)
-        self.rigid_mode_stiffness = float(rigid_mode_stiffness)  # checks.unheld_bodies
+        self.predictor_gap = float(c.predictor_gap)
+        self.rigid_mode_stiffness = float(fo.rigid_mode_stiffness)  # checks.unheld_bodies
         self.laws = {int(t): as_law(m) for t, m in materials.items()}
         self.materials = self.laws
-
         with self.phase("assembly"):
-            self.integration = None
-            if getattr(scene, "cut", None) is not None:
-                if degree != 1 or scene.cell_type != "quadrilateral":
-                    raise ValueError(
-                        "degree: the cut path supports Q1 (degree 1) on " "quadrilaterals only"
-                    )
-                from dolfinx_forms.fem.cut import CutIntegration
-
-                self.integration = CutIntegration(scene, degree=cut_degree)
-            self.V = fem.VectorFunctionSpace(self.mesh, ("Lagrange", degree))
-            self.u = fem.Function(self.V, name="u")
-            self.du = fem.Function(self.V)
-            self._rc = fem.Function(self.V)  # contact residual, scattered in reverse
-            self.bulk = BulkForms(
-                self.u,
-                scene,
-                self.laws,
-                tractions=tractions,
-                loads=loads,
-                integration=self.integration,
-                ghost_penalty=ghost_penalty,
-                quadrature_degree=quadrature_degree,
-                rigid_mode_stiffness=rigid_mode_stiffness,
-            )
-            self.dirichlet = list(dirichlet)
-            self.bc_dofs = [dirichlet_dofs(self.V, scene, d) for d in self.dirichlet]
-            imap = self.V.dofmap.index_map
-            self.bs = self.V.dofmap.index_map_bs
-            self.n_owned = imap.size_local * self.bs
-            self.num_dofs = imap.size_global * self.bs
-            # small problems (and MPI ranks sharing the cores) run their dense kernels on one
-            # BLAS thread: faster, and no spinning threads waiting for a busy core (`blas`)
-            small = self.num_dofs < defaults.TUNING.blas_one_thread_dofs
-            blas.threads_for(self.comm.size > 1 or small)
-            all_bc = (
-                np.unique(np.concatenate(self.bc_dofs)) if self.bc_dofs else np.zeros(0, np.int32)
-            )
-            self.bc_owned = all_bc[all_bc < self.n_owned].astype(np.int32)
-            self.bc_global = (self.bc_owned + imap.local_range[0] * self.bs).astype(np.int32)
-
+            self._bulk(fo, dirichlet, tractions, loads)
         h = scene.h_contact
-        self.band = band if band is not None else 2 * h
+        self.band = c.band if c.band is not None else 2 * h
         E_c = contact_modulus(scene, self.laws, obstacles)
-        self.eps_n = self.eps_t = penalty_parameter(eps0, h, E_c)  # eq 51
-        if multipliers == "default":
-            multipliers = "P1" if enforcement == "augmented" else None
-        if traction == "default":
-            traction = "points" if enforcement == "augmented" else "nodes"
-        if traction not in TRACTIONS:
-            raise ValueError(f"traction must be one of {TRACTIONS}, got {traction!r}")
-        projected = enforcement == "augmented" and multipliers == "P1" and traction == "points"
-        if multiplier_mass is None:  # the default where Uzawa projects on P1 nodes
-            multiplier_mass = DEFAULT_MULTIPLIER_MASS if projected else "lumped"
-        if multiplier_mass not in MULTIPLIER_MASSES:
-            raise ValueError(
-                f"multiplier_mass must be one of {MULTIPLIER_MASSES}, got {multiplier_mass!r}"
-            )
-        consistent = multiplier_mass != "lumped"  # "consistent" or "hybrid"
-        self.multiplier_mass = multiplier_mass
-        if consistent and not projected:
-            raise ValueError(
-                f"multiplier_mass {multiplier_mass!r} needs enforcement 'augmented' with P1 "
-                f"multipliers and traction 'points', got {enforcement!r}, {multipliers!r}, "
-                f"{traction!r}"
-            )
-        relaxation, eps_t_start, tune = 1.0, None, defaults.TUNING
-        if enforcement == "augmented" and multipliers is not None and traction == "points":
-            # the point-wise regularisation is part of the discretisation; eps0 sets the step
-            k_n = tune.consistent_eps0 if consistent else tune.pointwise_eps0
-            fine = penalty_parameter(k_n, h, E_c)
-            relaxation = min(1.0, fine / self.eps_n)
-            self.eps_n, self.eps_t = fine, penalty_parameter(tune.pointwise_eps0_t, h, E_c)
-            eps_t_start = self.eps_t
-            if consistent:
-                self.eps_t = penalty_parameter(tune.consistent_eps0_t, h, E_c)
-        if multiplier_length is None:
-            spacing = 1.5 if self.integration is not None else 1.0  # the lumped projection's
-            multiplier_length = h * (tune.consistent_length if consistent else spacing)
+        settings = enforcement(c, h, E_c, cut=self.integration is not None)
+        self.eps_n, self.eps_t = settings["eps_n"], settings["eps_t"]
+        self.multiplier_mass = settings["multiplier_mass"]
         with self.phase("contact"):
             self.contact = ContactSet(
-                self.V,
-                scene,
-                self.eps_n,
-                self.eps_t,
-                mu,
-                self.band,
-                grid_refine,
-                num_gauss,
-                contact_rank,
-                obstacles,
-                pair_grid_origin,
-                multipliers=multipliers,
-                multiplier_length=multiplier_length,
-                enforcement=enforcement,
-                traction=traction,
-                relaxation=relaxation,
-                multiplier_mass=multiplier_mass,
-                eps_t_start=eps_t_start,
+                self.V, scene, band=self.band, obstacles=obstacles, **settings
             )
         self.pairs = self.contact.pairs
-
         with self.phase("assembly"):
-            # Sparsity: mesh couplings + contact coupling blocks (+ ghost-penalty cell pairs);
-            # the pattern never changes.
-            pattern = _dcpp.fem.create_sparsity_pattern(
-                self.mesh.topology,
-                [self.V.dofmap._cpp_object, self.V.dofmap._cpp_object],
-                {_dcpp.fem.IntegralType.cell},
-            )
-            self.contact.insert_couplings(pattern)
-            if self.integration is not None and ghost_penalty > 0:
-                self.integration.insert_ghost_couplings(pattern, self.V)
-            pattern.assemble()
-            self.K = _dcpp.la.petsc.create_matrix(self.comm, pattern)
-            self.K.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
-            self.bulk.assemble_linear(self.K)
-            self.K.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)  # assemble_matrix ends in INSERT
-            self.K.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
-            self.contact.add_zeros(self.K)
-            self.K.assemble()
-            self.J = self.K.duplicate(copy=False)
-            self.J_key = None  # newton._keep: the key of the tangent J holds (None: none)
-            self.J.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
-            # zeroRows must not shrink the pattern: MatCopy(SAME_NONZERO_PATTERN) each
-            # iteration and the reuse of the symbolic LU factorisation depend on it
-            self.J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
-            self.R = self.K.createVecLeft()
-            self.Ku = self.K.createVecLeft()
-            self.f = self.K.createVecLeft()
-
+            self._matrices(fo.ghost_penalty)
         with self.phase("solve"):  # the condensed bulk is factorised here, once
-            self.linear = linear.choose(self, linear_solver, petsc_options)
+            self.linear = linear.choose(self, so.linear_solver, so.petsc_options)
         self.control = None  # force_control.ForceControl while a force-controlled stage runs
         self.u_committed = self.u.x.array.copy()
         self.lam = 0.0
         self.steps = []
+
+    def _bulk(self, fo, dirichlet, tractions, loads):
+        """Function space, bulk forms (cut integration on a cut scene), Dirichlet dofs."""
+        scene = self.scene
+        self.integration = None
+        if getattr(scene, "cut", None) is not None:
+            if fo.degree != 1 or scene.cell_type != "quadrilateral":
+                raise ValueError("degree: the cut path supports Q1 (degree 1) on quadrilaterals")
+            from dolfinx_forms.fem.cut import CutIntegration
+
+            self.integration = CutIntegration(scene, degree=fo.cut_degree)
+        self.V = fem.VectorFunctionSpace(self.mesh, ("Lagrange", fo.degree))
+        self.u = fem.Function(self.V, name="u")
+        self.du = fem.Function(self.V)
+        self._rc = fem.Function(self.V)  # contact residual, scattered in reverse
+        self.bulk = BulkForms(
+            self.u,
+            scene,
+            self.laws,
+            tractions=tractions,
+            loads=loads,
+            integration=self.integration,
+            ghost_penalty=fo.ghost_penalty,
+            quadrature_degree=fo.quadrature_degree,
+            rigid_mode_stiffness=fo.rigid_mode_stiffness,
+        )
+        self.dirichlet = list(dirichlet)
+        self.bc_dofs = [dirichlet_dofs(self.V, scene, d) for d in self.dirichlet]
+        imap = self.V.dofmap.index_map
+        self.bs = self.V.dofmap.index_map_bs
+        self.n_owned = imap.size_local * self.bs
+        self.num_dofs = imap.size_global * self.bs
+        # small problems (and MPI ranks sharing the cores) run their dense kernels on one
+        # BLAS thread: faster, and no spinning threads waiting for a busy core (`blas`)
+        small = self.num_dofs < defaults.TUNING.blas_one_thread_dofs
+        blas.threads_for(self.comm.size > 1 or small)
+        all_bc = np.zeros(0, np.int32)
+        if self.bc_dofs:
+            all_bc = np.unique(np.concatenate(self.bc_dofs))
+        self.bc_owned = all_bc[all_bc < self.n_owned].astype(np.int32)
+        self.bc_global = (self.bc_owned + imap.local_range[0] * self.bs).astype(np.int32)
+
+    def _matrices(self, ghost_penalty):
+        """Sparsity: mesh couplings + contact coupling blocks (+ ghost-penalty cell pairs); the
+        pattern never changes. K (the linear bulk), J (the tangent), R, Ku, f."""
+        pattern = _dcpp.fem.create_sparsity_pattern(
+            self.mesh.topology,
+            [self.V.dofmap._cpp_object, self.V.dofmap._cpp_object],
+            {_dcpp.fem.IntegralType.cell},
+        )
+        self.contact.insert_couplings(pattern)
+        if self.integration is not None and ghost_penalty > 0:
+            self.integration.insert_ghost_couplings(pattern, self.V)
+        pattern.assemble()
+        self.K = _dcpp.la.petsc.create_matrix(self.comm, pattern)
+        self.K.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
+        self.bulk.assemble_linear(self.K)
+        self.K.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)  # assemble_matrix ends in INSERT
+        self.K.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
+        self.contact.add_zeros(self.K)
+        self.K.assemble()
+        self.J = self.K.duplicate(copy=False)
+        self.J_key = None  # newton._keep: the key of the tangent J holds (None: none)
+        self.J.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
+        # zeroRows must not shrink the pattern: MatCopy(SAME_NONZERO_PATTERN) each iteration
+        # and the reuse of the symbolic LU factorisation depend on it
+        self.J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
+        self.R = self.K.createVecLeft()
+        self.Ku = self.K.createVecLeft()
+        self.f = self.K.createVecLeft()
+
 
     # ------------------------------------------------------------------ utilities
     @property
@@ -423,3 +331,55 @@ def zone_ends(x, inside, gap=None):
         else:
             ends.append(0.5 * (x[k] + x[nb]))
     return ends[0], ends[1]
+
+
+def enforcement(c, h, E_c, cut):
+    """The ContactSet settings of the options `c` (ContactOptions) at mesh size h and contact
+    modulus E_c: defaults resolved, checked, and eq 51's regularisation. The penalty: eps_n =
+    eps_t = eps0 h / E_c. The augmented Lagrangian with point-wise traction: eps_n and eps_t
+    the tuned factors (defaults.TUNING) times h / E_c, part of the discretisation; eps0 then
+    relaxes the Uzawa step by min(1, eps_n / eps)."""
+    eps = penalty_parameter(c.eps0, h, E_c)  # eq 51
+    augmented = c.enforcement == "augmented"
+    multipliers = ("P1" if augmented else None) if c.multipliers == "default" else c.multipliers
+    traction = ("points" if augmented else "nodes") if c.traction == "default" else c.traction
+    if traction not in TRACTIONS:
+        raise ValueError(f"traction must be one of {TRACTIONS}, got {traction!r}")
+    projected = augmented and multipliers == "P1" and traction == "points"
+    mass = c.multiplier_mass
+    if mass is None:  # the default where Uzawa projects on P1 nodes
+        mass = DEFAULT_MULTIPLIER_MASS if projected else "lumped"
+    if mass not in MULTIPLIER_MASSES:
+        raise ValueError(f"multiplier_mass must be one of {MULTIPLIER_MASSES}, got {mass!r}")
+    consistent = mass != "lumped"  # "consistent" or "hybrid"
+    if consistent and not projected:
+        raise ValueError(
+            f"multiplier_mass {mass!r} needs enforcement 'augmented' with P1 multipliers and "
+            f"traction 'points', got {c.enforcement!r}, {multipliers!r}, {traction!r}"
+        )
+    out = dict(eps_n=eps, eps_t=eps, relaxation=1.0, eps_t_start=None)
+    tune = defaults.TUNING
+    if augmented and multipliers is not None and traction == "points":
+        k_n = tune.consistent_eps0 if consistent else tune.pointwise_eps0
+        fine = penalty_parameter(k_n, h, E_c)
+        out.update(eps_n=fine, relaxation=min(1.0, fine / eps))
+        out["eps_t"] = out["eps_t_start"] = penalty_parameter(tune.pointwise_eps0_t, h, E_c)
+        if consistent:
+            out["eps_t"] = penalty_parameter(tune.consistent_eps0_t, h, E_c)
+    length = c.multiplier_length
+    if length is None:
+        spacing = 1.5 if cut else 1.0  # the lumped projection's
+        length = h * (tune.consistent_length if consistent else spacing)
+    return dict(
+        out,
+        mu=c.mu,
+        grid_refine=c.grid_refine,
+        num_gauss=c.num_gauss,
+        rank=c.contact_rank,
+        lattice_origin=c.pair_grid_origin,
+        multipliers=multipliers,
+        multiplier_length=length,
+        enforcement=c.enforcement,
+        traction=traction,
+        multiplier_mass=mass,
+    )

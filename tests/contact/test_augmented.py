@@ -27,6 +27,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from dolfinx_forms.solvers.options import options
+
 ROOT = Path(__file__).resolve().parents[2]
 EXACT = 0.01 / (1 - 0.3**2) / 1.0  # E' d / H with E = 1, nu = 0.3, d = 0.01, H = 1
 
@@ -152,16 +154,13 @@ def test_traction_at_nodes_zero_mean_gap():
         p = ContactProblem(
             scene,
             {b.tag: (1e4, 0.3) for b in scene.bodies},
-            eps0=eps0,
-            band=0.13,
             dirichlet=[
                 Dirichlet("block_bottom", None, 0.0),
                 Dirichlet("cylinder_top", 0, 0.0),
                 Dirichlet("cylinder_top", 1, lambda lam: -0.15 * lam),
             ],
-            enforcement="augmented",
-            traction="nodes",
             log=lambda *a: None,
+            **options(eps0=eps0, band=0.13, enforcement="augmented", traction="nodes"),
         )
         assert p.contact.relaxation == 1.0 and p.eps_n == eps0 * 0.1 / 1e4
         p.solve(1)
@@ -185,11 +184,9 @@ def _cut_hertz_force(al_first, al_eta, fresh_border=False):
     pb = ContactProblem(
         sc,
         {b.tag: (1e4, 0.3) for b in sc.bodies},
-        band=1.6**2 / 20.0,
         dirichlet=[Dirichlet("block_bottom", None, 0.0), Dirichlet("cylinder_top", 0, 0.0), top],
-        enforcement="augmented",
-        linear_solver="condensed",
         log=lambda *a, **k: None,
+        **options(band=1.6**2 / 20.0, enforcement="augmented", linear_solver="condensed"),
     )
     pb.newton.al_first, pb.newton.al_eta = al_first, al_eta
     calls = []
@@ -243,10 +240,8 @@ def test_consistent_projection_returns_p1_fields():
     p = ContactProblem(
         scene,
         {b.tag: (1e4, 0.3) for b in scene.bodies},
-        band=0.13,
-        enforcement="augmented",
-        multiplier_mass="consistent",
         log=lambda *a: None,
+        **options(band=0.13, enforcement="augmented", multiplier_mass="consistent"),
     )
     (g,) = p.contact.pairs
     assert g.multiplier_mass == "consistent" and p.contact.eps_n == 1.0 * 0.2 / 1e4
@@ -255,15 +250,24 @@ def test_consistent_projection_returns_p1_fields():
     assert np.abs(g.consistent_projection(pts) - nodes).max() <= 1e-12 * np.abs(nodes).max()
     assert np.abs(g.project(pts)[0] - nodes).max() > 1e-2  # lumped: a weighted mean
     with pytest.raises(ValueError, match="multiplier_mass"):
-        ContactProblem(scene, {b.tag: (1e4, 0.3) for b in scene.bodies}, multiplier_mass="x")
+        ContactProblem(
+            scene,
+            {b.tag: (1e4, 0.3) for b in scene.bodies},
+            **options(multiplier_mass="x"),
+        )
     for mass in ("consistent", "hybrid"):
         with pytest.raises(ValueError, match="needs enforcement 'augmented'"):
-            ContactProblem(scene, {b.tag: (1e4, 0.3) for b in scene.bodies}, multiplier_mass=mass)
+            ContactProblem(
+                scene,
+                {b.tag: (1e4, 0.3) for b in scene.bodies},
+                **options(multiplier_mass=mass),
+            )
     # the defaults: hybrid with the augmented Lagrangian, nothing to project with the penalty
     laws = {b.tag: (1e4, 0.3) for b in scene.bodies}
-    quiet = dict(band=0.13, log=lambda *a: None)
-    assert ContactProblem(scene, laws, enforcement="augmented", **quiet).multiplier_mass == "hybrid"
-    assert ContactProblem(scene, laws, **quiet).multiplier_mass == "lumped"
+    quiet = dict(log=lambda *a: None)
+    augmented = options(band=0.13, enforcement="augmented")
+    assert ContactProblem(scene, laws, **quiet, **augmented).multiplier_mass == "hybrid"
+    assert ContactProblem(scene, laws, **quiet, **options(band=0.13)).multiplier_mass == "lumped"
 
 
 def test_hybrid_projection_rows():
@@ -279,7 +283,12 @@ def test_hybrid_projection_rows():
 
     scene = hertz_scene(MPI.COMM_SELF, R=10.0, width=20.0, depth=10.0, h=0.2, zone=1.6)
     laws = {b.tag: (1e4, 0.3) for b in scene.bodies}
-    p = ContactProblem(scene, laws, band=0.13, enforcement="augmented", log=lambda *a: None)
+    p = ContactProblem(
+        scene,
+        laws,
+        log=lambda *a: None,
+        **options(band=0.13, enforcement="augmented"),
+    )
     (g,) = p.contact.pairs
     assert g.multiplier_mass == "hybrid" and p.contact.eps_n == 1.0 * 0.2 / 1e4
     nodes = np.sin(np.arange(g.num_nodes) * 0.7) - 2.0
@@ -313,7 +322,9 @@ def test_hybrid_projection_rows():
     assert np.allclose(g.hybrid_projection(pts, np.ones(n_pts, bool)), full, rtol=0, atol=1e-13)
     with pytest.raises(ValueError, match="needs enforcement 'augmented'"):
         ContactProblem(
-            scene, {b.tag: (1e4, 0.3) for b in scene.bodies}, multiplier_mass="consistent"
+            scene,
+            {b.tag: (1e4, 0.3) for b in scene.bodies},
+            **options(multiplier_mass="consistent"),
         )
 
 
@@ -364,10 +375,9 @@ def _cut_mindlin(direct):
     pb = ContactProblem(
         sc,
         {b.tag: (1e4, 0.3) for b in sc.bodies},
-        band=1.6**2 / 20.0,
         dirichlet=[Dirichlet("block_bottom", None, 0.0), x, y],
-        enforcement="augmented",
         log=lambda *a, **k: None,
+        **options(band=1.6**2 / 20.0, enforcement="augmented"),
     )
     if direct:
         pb.contact.eps_t_start = pb.contact.eps_t_final

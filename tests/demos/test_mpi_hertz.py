@@ -15,6 +15,7 @@ import pytest
 from mpi4py import MPI
 
 from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 from meshes.cut import hertz_cut_scene
 from meshes.hertz import hertz_scene
@@ -35,13 +36,11 @@ def reaction(comm, mu, disc="conforming", enforcement="penalty", band=0.13, box=
     p = ContactProblem(
         scene,
         mat,
-        mu=0.0,
-        eps0=0.5,
-        band=band,
         dirichlet=[Dirichlet("block_bottom", None, 0.0), top_x, top_y],
-        enforcement=enforcement,
-        multiplier_mass=mass or "lumped",
         log=lambda *a: None,
+        **options(
+            mu=0.0, eps0=0.5, band=band, enforcement=enforcement, multiplier_mass=mass or "lumped"
+        ),
     )
     p.solve(2)
     if mu > 0:  # a frictional tangential step: history and stick/slip in parallel too

@@ -13,6 +13,7 @@ from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.fem.laws import LinearElastic, NeoHookean, OrthotropicElastic
 from dolfinx_forms.mesh.scene import Body, Scene, tag_boundaries
 from dolfinx_forms.solvers.newton import NewtonOptions
+from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 
 E, NU = 1000.0, 0.3
@@ -51,7 +52,11 @@ def punch(scene, law, depth, steps=1):
         Dirichlet("punch", 1, lambda lam: -lam * depth),
     ]
     p = ContactProblem(
-        scene, {1: law}, dirichlet=bcs, newton=NewtonOptions(rtol=1e-11), log=lambda *a: None
+        scene,
+        {1: law},
+        dirichlet=bcs,
+        log=lambda *a: None,
+        **options(newton=NewtonOptions(rtol=1e-11)),
     )
     p.solve(steps)
     return p
@@ -153,7 +158,11 @@ def cut_punch(scene, law, depth):
         Dirichlet("punch", 1, lambda lam: -lam * depth),
     ]
     p = ContactProblem(
-        scene, {1: law}, dirichlet=bcs, newton=NewtonOptions(rtol=1e-11), log=lambda *a: None
+        scene,
+        {1: law},
+        dirichlet=bcs,
+        log=lambda *a: None,
+        **options(newton=NewtonOptions(rtol=1e-11)),
     )
     p.solve(1)
     return p

@@ -11,6 +11,7 @@ from test_laws import E, H, NU, block_scene, cut_block_scene
 from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.fem.laws import NeoHookean, OrthotropicElastic
 from dolfinx_forms.solvers.newton import NewtonOptions
+from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 
 SCENES = {  # name -> (scene on a communicator, the clamped boundary)
@@ -26,7 +27,11 @@ def solve(scene, clamped, law):
         Dirichlet("punch", 1, lambda lam: -0.1 * H * lam),
     ]
     p = ContactProblem(
-        scene, {1: law}, dirichlet=bcs, newton=NewtonOptions(rtol=1e-11), log=lambda *a: None
+        scene,
+        {1: law},
+        dirichlet=bcs,
+        log=lambda *a: None,
+        **options(newton=NewtonOptions(rtol=1e-11)),
     )
     p.solve(1)
     return p.reaction("punch"), p.steps[-1].iterations, p.num_dofs

@@ -10,6 +10,7 @@ from mpi4py import MPI
 
 import dolfinx_forms as df
 from dolfinx_forms.mesh.cut_scene import CutBody, cut_scene, half_plane
+from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 from meshes.patch import patch_dirichlet
 from dolfinx_forms.mesh.scene import (
@@ -102,11 +103,9 @@ def solve(scene):
     p = ContactProblem(
         scene,
         {b.tag: (E, NU) for b in scene.bodies},
-        mu=0.0,
-        eps0=1.0,
-        band=0.5 / N,
         dirichlet=patch_dirichlet(D),
         log=lambda *a, **k: None,
+        **options(mu=0.0, eps0=1.0, band=0.5 / N),
     )
     p.solve(1)
     pts = p.contact_points()

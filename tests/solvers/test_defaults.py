@@ -7,6 +7,7 @@ import pytest
 from mpi4py import MPI
 
 from dolfinx_forms import defaults
+from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 from meshes.cut import patch_cut_scene
 from meshes.patch import patch_dirichlet
@@ -27,7 +28,10 @@ def test_tuning_is_read_when_a_problem_is_made(monkeypatch):
 
     def problem():
         return ContactProblem(
-            scene, laws, dirichlet=patch_dirichlet(0.01), enforcement="augmented", band=0.1
+            scene,
+            laws,
+            dirichlet=patch_dirichlet(0.01),
+            **options(enforcement="augmented", band=0.1),
         )
 
     before = problem()

@@ -9,6 +9,7 @@ from petsc4py import PETSc
 
 from dolfinx_forms.solvers import linear, protocol
 from dolfinx_forms.solvers.newton import ContactSolverError
+from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 
 from test_linear import P, hertz_problem, scene
@@ -75,13 +76,15 @@ def patch_iterations(eta, gamma, petsc_options=None, n=20, eps0=0.5):
     pb = ContactProblem(
         sc,
         {b.tag: (1.0, 0.3) for b in sc.bodies},
-        eps0=eps0,
-        band=0.5 / n,
-        ghost_penalty=gamma,
         dirichlet=patch_dirichlet(0.01, 1.0),
-        linear_solver="iterative",
-        petsc_options=petsc_options,
         log=lambda *a, **k: None,
+        **options(
+            eps0=eps0,
+            band=0.5 / n,
+            ghost_penalty=gamma,
+            linear_solver="iterative",
+            petsc_options=petsc_options,
+        ),
     )
     pb.solve()
     return max(pb.linear.iterations)

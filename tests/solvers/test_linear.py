@@ -16,6 +16,7 @@ from dolfinx_forms import defaults
 from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.fem.laws import NeoHookean
 from dolfinx_forms.solvers import linear, protocol
+from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 
 E, NU, R, P = 1.0e4, 0.3, 10.0, 430.0
@@ -37,11 +38,9 @@ def hertz_problem(sc, linear_solver, materials=None):
     pb = ContactProblem(
         sc,
         materials or {b.tag: (E, NU) for b in sc.bodies},
-        eps0=0.5,
-        band=1.6**2 / (2 * R),
         dirichlet=[Dirichlet("block_bottom", None, 0.0), top_x, top_y],
-        linear_solver=linear_solver,
         log=lambda *a, **k: None,
+        **options(eps0=0.5, band=1.6**2 / (2 * R), linear_solver=linear_solver),
     )
     return pb, top_x, top_y
 
@@ -207,10 +206,15 @@ def test_tangent_kept_while_its_key_holds(kind, enforcement, monkeypatch):
 
     counted.__wrapped__ = CP.residual
     monkeypatch.setattr(CP, "residual", counted)
+    from dolfinx_forms.solvers.options import ContactOptions
+
     init = CP.__init__
-    monkeypatch.setattr(
-        CP, "__init__", lambda s, *a, **k: init(s, *a, **k, enforcement=enforcement)
-    )
+
+    def with_enforcement(s, *a, contact=None, **k):
+        contact = dataclasses.replace(contact or ContactOptions(), enforcement=enforcement)
+        init(s, *a, contact=contact, **k)
+
+    monkeypatch.setattr(CP, "__init__", with_enforcement)
 
     def run():
         counts.append(0)

@@ -14,6 +14,7 @@ from mpi4py import MPI
 from dolfinx_forms.fem.boundary import Dirichlet, Traction
 from dolfinx_forms.solvers import protocol
 from dolfinx_forms.solvers.newton import ContactSolverError
+from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 
 E, NU, N = 1.0, 0.3, 3
@@ -40,11 +41,10 @@ def patch_problem(scene, tractions=(), log=lambda *a, **k: None):
     p = ContactProblem(
         scene,
         {b.tag: (E, NU) for b in scene.bodies},
-        eps0=1.0,
-        band=0.5 / N,
         dirichlet=bcs,
         tractions=tractions,
         log=log,
+        **options(eps0=1.0, band=0.5 / N),
     )
     return p, top
 

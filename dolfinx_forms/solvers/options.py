@@ -1,0 +1,94 @@
+"""The options of a ContactProblem, grouped by what they set: the contact law and its
+enforcement (`ContactOptions`), the bulk discretisation (`FemOptions`) and the solvers
+(`SolverOptions`). `options(**kw)` sorts flat keywords into the three groups (the demos' and
+scenes' parameters name them flat); an unknown name is a TypeError naming it.
+
+    ContactProblem(scene, laws, dirichlet=bcs, contact=ContactOptions(mu=0.3, eps0=0.5))
+    ContactProblem(scene, laws, dirichlet=bcs, **options(mu=0.3, eps0=0.5, degree=2))
+"""
+
+from dataclasses import dataclass, fields
+
+
+@dataclass
+class ContactOptions:
+    """The contact law (eqs 8-12) and its enforcement.
+
+    mu: Coulomb friction coefficient (0: frictionless, no friction work). eps0: the penalty
+    factor of eq 51, eps_n = eps_t = eps0 h / E_c (`contact.penalty`); with "augmented" it sets
+    only the Uzawa step. band: the largest initial gap that Gamma_c covers (a length; default
+    2 h). enforcement: "penalty" (the answer depends on eps0) or "augmented" (augmented
+    Lagrangian, Uzawa loop, `contact.contact_set`). multipliers: None (a traction per contact
+    point), "P0" or "P1" (one traction per node along Gamma_c, nodes multiplier_length apart);
+    "default": "P1" with "augmented", None with "penalty". multiplier_length: default h
+    body-fitted, 1.5 h cut (consistent_length h with the consistent or hybrid projection).
+    traction: "nodes" (the law on each node's weighted mean gap) or "points" (the law at each
+    point with the multipliers interpolated; eps_n and eps_t then the tuned factors of
+    `defaults.TUNING` times h / E_c); "default": "points" with "augmented". multiplier_mass
+    (augmented, P1, traction "points"): "hybrid" (default), "consistent" or "lumped".
+    grid_refine, num_gauss: the pair level-set grid's refinement and the Gauss points per
+    Gamma_c segment. pair_grid_origin: None, or a point every pair's level-set grid passes
+    through (symmetric scenes stay symmetric). predictor_gap: in a step's first Newton
+    iteration, open points with a gap below it add a closed point's tangent (no force; holds
+    bodies whose contacts touch but are not closed yet). contact_rank: the rank that holds
+    Gamma_c's cells (contact_box partitioning)."""
+
+    mu: float = 0.0
+    eps0: float = 1.0
+    band: float | None = None
+    enforcement: str = "penalty"
+    multipliers: str | None = "default"
+    multiplier_length: float | None = None
+    traction: str = "default"
+    multiplier_mass: str | None = None
+    grid_refine: int = 4
+    num_gauss: int = 2
+    pair_grid_origin: object = None
+    predictor_gap: float = 0.0
+    contact_rank: int = 0
+
+
+@dataclass
+class FemOptions:
+    """The bulk discretisation. degree: Lagrange degree (1 or 2; 1 on a cut scene).
+    quadrature_degree: see `fem.bulk.BulkForms`. cut_degree: the cut cells' moment-fitted
+    rule (`fem.cut.CutIntegration`). ghost_penalty: on the faces of cut cells (0: none).
+    rigid_mode_stiffness: alpha of a spring alpha E / L^2 on every body's displacement, for
+    bodies held by contact alone (free grains; changes the answer by ~alpha; 0: none)."""
+
+    degree: int = 1
+    quadrature_degree: int | None = None
+    cut_degree: int = 4
+    ghost_penalty: float = 0.01
+    rigid_mode_stiffness: float = 0.0
+
+
+@dataclass
+class SolverOptions:
+    """newton: `solvers.newton.NewtonOptions` (default: its defaults). petsc_options: PETSc
+    options of the linear solves. linear_solver: "auto", "condensed", "factorised" or
+    "iterative" (`solvers.linear`: a linear bulk on one process is factorised once and Newton
+    runs on the Schur complement of the contact dofs; "iterative": CG + GAMG with the
+    rigid-body modes, chosen by "auto" for large body-fitted problems)."""
+
+    newton: object = None
+    petsc_options: dict | None = None
+    linear_solver: str = "auto"
+
+
+GROUPS = {"contact": ContactOptions, "fem": FemOptions, "solver": SolverOptions}
+_FIELD_GROUP = {f.name: g for g, cls in GROUPS.items() for f in fields(cls)}
+
+
+def options(**kw):
+    """{"contact": ContactOptions, "fem": FemOptions, "solver": SolverOptions} from flat
+    keywords (module doc); a TypeError names an unknown one."""
+    split = {g: {} for g in GROUPS}
+    for name, value in kw.items():
+        if name not in _FIELD_GROUP:
+            raise TypeError(f"ContactProblem: unknown option {name!r}")
+        split[_FIELD_GROUP[name]][name] = value
+    return {g: GROUPS[g](**values) for g, values in split.items()}
+
+
+__all__ = ["ContactOptions", "FemOptions", "SolverOptions", "options"]
