@@ -41,13 +41,12 @@ from mpi4py import MPI
 
 from dolfinx_forms import _cpp
 from dolfinx_forms.mpm import material_points as mp
-from dolfinx_forms.common import allreduce_array
-from dolfinx_forms.contact.resultants import traction_resultant
 from dolfinx_forms.fem.boundary import Load
 from dolfinx_forms.fem.cut import grid_cells
 from dolfinx_forms.fem.laws import as_law, law_key
+from dolfinx_forms.mpm import evolution, records
 from dolfinx_forms.solvers.options import options
-from dolfinx_forms.solvers.problem import ContactProblem, zone_ends
+from dolfinx_forms.solvers.problem import ContactProblem
 
 
 @dataclass
@@ -229,11 +228,11 @@ class ImplicitMPM:
             self.points = {b.tag: mp.seed(scene, problem.integration, b.tag) for b in self.bodies}
         keys = problem.contact.names(scene)
         with self.phase("contact"):
-            self._transfer_friction(problem, keys)
+            records.transfer_friction(self, problem, keys)
         problem.solve(1, 1.0, label=f"MPM step {self.step_count + 1}")
         # ---- converged: from here on the state changes
-        record = self._contact_record(problem, scene, keys)
-        record["support_forces"] = self._support_forces(problem, scene)
+        record = records.contact_record(self, problem, scene, keys)
+        record["support_forces"] = records.support_forces(self, problem, scene)
         with self.phase("points"):
             outside = 0
             moved = []
@@ -246,7 +245,7 @@ class ImplicitMPM:
             if self.step_count == 0:
                 self.first_step_du = moved
         with self.phase("evolution"):
-            evo = self._evolve(problem, scene)
+            evo = evolution.evolve(self, problem, scene)
         for ob in self.obstacles:
             ob.advance(1.0)
         self.step_count += 1
@@ -369,173 +368,3 @@ class ImplicitMPM:
         if widened:
             self.log(f"MLS: {widened} integration points needed a wider support (reported)")
         return sigma0, {"widened": widened}
-
-    def _support_forces(self, problem, scene):
-        """{body: [fx, fy]} exerted on each body by its Dirichlet conditions: the residual
-        (internal - external + contact forces) summed over the body's prescribed dofs."""
-        out = {}
-        if not problem.dirichlet:
-            return {b.name: [0.0, 0.0] for b in self.bodies}
-        problem.residual(1.0, zero_bc=False)
-        R = problem.R.array.reshape(-1, 2)
-        owned = problem.n_owned
-        bc = np.zeros(owned, bool)
-        bc[problem.bc_owned] = True
-        cell_dofs = problem.V.dofmap.list.array.reshape(-1, 4)
-        for b in self.bodies:
-            nodes = np.unique(cell_dofs[scene.cell_tags.find(b.tag)])
-            nodes = nodes[2 * nodes + 1 < owned]
-            f = np.zeros(2)
-            for c in range(2):
-                sel = bc[2 * nodes + c]
-                f[c] = R[nodes[sel], c].sum()
-            out[b.name] = allreduce_array(self.comm, f, MPI.SUM).tolist()
-        return out
-
-    def _transfer_friction(self, problem, keys):
-        """Each new contact point starts from the elastic tangential gap e_t = g_t - g_t^p of
-        the nearest contact point of the same pair in the previous step (moved with the
-        bodies) if one lies within h, else from zero tangential traction: its committed slip is
-        set to -e_t, so the trial traction at du = 0 is the old one (eq 11)."""
-        cs = problem.contact
-        if cs.mu == 0:
-            return
-        from scipy.spatial import cKDTree
-
-        for k, g in enumerate(cs.pairs):
-            old = self.friction.get(keys[k])
-            gtp = np.zeros(len(g.weights))
-            if old is not None and len(old[0]):
-                d, idx = cKDTree(old[0]).query(g.points)
-                near = d <= self.h
-                gtp[near] = -old[1][idx[near]]
-            cs.set_committed_slip(k, gtp)
-
-    def _contact_record(self, problem, scene, keys):
-        """Per pair: resultants, active zone, stick fraction; per obstacle: force and moment;
-        the friction record for the next step (points moved by the mean step displacement)."""
-        cs = problem.contact
-        pairs = []
-        self.friction = {}
-        for k, g in enumerate(cs.pairs):
-            s = cs.committed[k]
-            active = s["state"] != 0
-            w = g.weights
-            pn, pt = -s["tau_n"], s["tau_t"]
-            order = np.argsort(g.points[:, 0])
-            xl, xr = zone_ends(g.points[order, 0], active[order], s["g_n"][order])
-            wa = w[active]
-            f = traction_resultant(g, s, "j")[0]  # on body j (the obstacle) from body i
-            pairs.append(
-                dict(
-                    fx=float(f[0]),
-                    fy=float(f[1]),
-                    body_i=keys[k][0],
-                    body_j=keys[k][1],
-                    x=float(np.average(g.points[active, 0], weights=wa)) if active.any() else 0.0,
-                    y=float(np.average(g.points[active, 1], weights=wa)) if active.any() else 0.0,
-                    normal_force=float(np.sum(w * pn)),
-                    tangential_force=float(np.sum(w * pt)),
-                    active_length=float(np.sum(wa)),
-                    stick_fraction=float(np.sum(w[s["state"] == 1]) / np.sum(wa))
-                    if active.any()
-                    else 0.0,
-                    half_width=0.0 if xl is None else 0.5 * (xr - xl),
-                    num_points=int(len(w)),
-                )
-            )
-            if cs.mu > 0:
-                self.friction[keys[k]] = (g.points.copy(), cs.elastic_slip(k))
-        # each pair lives on one rank: share the records, in the order of one rank
-        gathered = self.comm.allgather(list(zip(cs.index, pairs)))
-        pairs = [p for _, p in sorted((q for lst in gathered for q in lst), key=lambda q: q[0])]
-        self.friction = {k: v for d in self.comm.allgather(self.friction) for k, v in d.items()}
-        # contact resultants on each body: +sum w (tau_n n + tau_t t) on side i, the opposite on
-        # side j; moment about the body's material-point centroid
-        forces = {b.name: np.zeros(3) for b in self.bodies}
-        for k, g in enumerate(cs.pairs):
-            s = cs.committed[k]
-            for side, name, p in (("i", keys[k][0], g.p_i), ("j", keys[k][1], g.p_j)):
-                if name in forces:
-                    b = next(b for b in self.bodies if b.name == name)
-                    c = np.average(self.points[b.tag].x, axis=0, weights=self.points[b.tag].vol)
-                    F, M = traction_resultant(g, s, side, p, c)
-                    forces[name] += np.array([F[0], F[1], M])
-        body_forces = {
-            n: allreduce_array(self.comm, v, MPI.SUM).tolist() for n, v in forces.items()
-        }
-        res = cs.obstacle_resultants()
-        obstacles = {}
-        for ob in self.obstacles:
-            F, M = res[ob.name]
-            F = allreduce_array(self.comm, np.asarray(F, float), MPI.SUM)
-            obstacles[ob.name] = dict(
-                fx=float(F[0]), fy=float(F[1]), moment=self.comm.allreduce(M, op=MPI.SUM)
-            )
-        return dict(pairs=pairs, obstacles=obstacles, body_forces=body_forces)
-
-    def _evolve(self, problem, scene):
-        """Extend du off each body (eq 20), advect its level set (eq 19), reinitialise on drift."""
-        V = problem.V
-        nx, ny = len(self.xlines), len(self.ylines)
-        xdof = V.tabulate_dof_coordinates()[:, :2]
-        i = np.rint((xdof[:, 0] - self.xlines[0]) / self.h).astype(np.int64)
-        j = np.rint((xdof[:, 1] - self.ylines[0]) / self.h).astype(np.int64)
-        node = i + nx * j
-        owned = V.dofmap.index_map.size_local
-        cell_dofs = V.dofmap.list.array.reshape(-1, 4)
-        u = problem.u.x.array.reshape(-1, 2)
-        out = dict(area_levelset={}, advection_substeps={}, reinitialized={}, gradient_drift={})
-        nn = self.grid.num_nodes
-        self.grid_increments = {}
-        for b in self.bodies:
-            dofs = np.unique(cell_dofs[scene.cell_tags.find(b.tag)])
-            dofs = dofs[dofs < owned]
-            vel = np.zeros((nn, 2))
-            has = np.zeros(nn, np.int8)
-            vel[node[dofs]] = u[dofs]
-            has[node[dofs]] = 1
-            vel = allreduce_array(self.comm, vel, MPI.SUM)
-            has = allreduce_array(self.comm, has, MPI.MAX)
-            phi = self.levelsets[b.tag]
-            # known: every node of the body's active cells. The FE increment on the outside
-            # nodes of cut cells is the unfitted method's own (smooth, ghost-penalised)
-            # extension, second order at the interface; the constant normal extension of
-            # eq 20 fills the rest of the grid. (Extending from the inside nodes only would move
-            # the interface by du at a node up to h inside: first order, and the level set
-            # would lag the material by ~ h grad(du) per step.)
-            known = (has > 0).reshape(ny, nx)
-            # a window of the grid around the body (its active nodes grown by 6 cells and the
-            # step's largest motion): a grain costs its own size, not the grid's. Beyond it the
-            # level set keeps its (positive, far-field) values.
-            jj, ii = np.nonzero(known)
-            m = 6 + int(np.ceil(np.abs(vel).max() / self.h))
-            i0, i1 = max(ii.min() - m, 0), min(ii.max() + m, nx - 1)
-            j0, j1 = max(jj.min() - m, 0), min(jj.max() + m, ny - 1)
-            win = (slice(j0, j1 + 1), slice(i0, i1 + 1))
-            sub = _cpp.StructuredGrid(self.xlines[i0 : i1 + 1], self.ylines[j0 : j1 + 1])
-            values = phi.values  # (ny, nx) copy
-            v = vel.reshape(ny, nx, 2)[win].reshape(-1, 2)
-            v = _cpp.extend_normal(
-                sub,
-                values[win].ravel(),
-                known[win].ravel().astype(np.int8),
-                np.ascontiguousarray(v),
-            )
-            full = np.zeros((ny, nx, 2))
-            full[win] = v.reshape(j1 - j0 + 1, i1 - i0 + 1, 2)
-            self.grid_increments[b.name] = full.reshape(-1, 2)
-            r = _cpp.advect_levelset(_cpp.LevelSet(sub, values[win].ravel()), v, 1.0, 0.5)
-            new = r["levelset"]
-            drift = float(_cpp.levelset_gradient_drift(new, 3 * self.h))
-            redo = drift > self.reinit_drift
-            if redo:
-                new = _cpp.reinitialize(new)
-            area = float(_cpp.levelset_area(new))
-            values[win] = new.values
-            self.levelsets[b.tag] = _cpp.LevelSet(self.grid, values.ravel())
-            out["area_levelset"][b.name] = area
-            out["advection_substeps"][b.name] = int(r["substeps"])
-            out["reinitialized"][b.name] = bool(redo)
-            out["gradient_drift"][b.name] = drift
-        return out

@@ -1,0 +1,119 @@
+"""What an implicit MPM step records and hands to the next one, from its converged state
+(ImplicitMPM.step): the contact record (pair resultants, zones, stick fractions; the bodies'
+contact forces and moments; the obstacles' forces), the supports' reactions, and the friction
+history carried to the next step's contact points (the contact set owns the history; this
+only finds, for each new point, the old point it continues)."""
+
+import numpy as np
+from mpi4py import MPI
+
+from dolfinx_forms.common import allreduce_array
+from dolfinx_forms.contact.resultants import traction_resultant
+from dolfinx_forms.solvers.problem import zone_ends
+
+
+def support_forces(sim, problem, scene):
+    """{body: [fx, fy]} exerted on each body by its Dirichlet conditions: the residual
+    (internal - external + contact forces) summed over the body's prescribed dofs."""
+    out = {}
+    if not problem.dirichlet:
+        return {b.name: [0.0, 0.0] for b in sim.bodies}
+    problem.residual(1.0, zero_bc=False)
+    R = problem.R.array.reshape(-1, 2)
+    owned = problem.n_owned
+    bc = np.zeros(owned, bool)
+    bc[problem.bc_owned] = True
+    cell_dofs = problem.V.dofmap.list.array.reshape(-1, 4)
+    for b in sim.bodies:
+        nodes = np.unique(cell_dofs[scene.cell_tags.find(b.tag)])
+        nodes = nodes[2 * nodes + 1 < owned]
+        f = np.zeros(2)
+        for c in range(2):
+            sel = bc[2 * nodes + c]
+            f[c] = R[nodes[sel], c].sum()
+        out[b.name] = allreduce_array(sim.comm, f, MPI.SUM).tolist()
+    return out
+
+
+def transfer_friction(sim, problem, keys):
+    """Each new contact point starts from the elastic tangential gap e_t = g_t - g_t^p of
+    the nearest contact point of the same pair in the previous step (moved with the
+    bodies) if one lies within h, else from zero tangential traction: its committed slip is
+    set to -e_t, so the trial traction at du = 0 is the old one (eq 11)."""
+    cs = problem.contact
+    if cs.mu == 0:
+        return
+    from scipy.spatial import cKDTree
+
+    for k, g in enumerate(cs.pairs):
+        old = sim.friction.get(keys[k])
+        gtp = np.zeros(len(g.weights))
+        if old is not None and len(old[0]):
+            d, idx = cKDTree(old[0]).query(g.points)
+            near = d <= sim.h
+            gtp[near] = -old[1][idx[near]]
+        cs.set_committed_slip(k, gtp)
+
+
+def contact_record(sim, problem, scene, keys):
+    """Per pair: resultants, active zone, stick fraction; per obstacle: force and moment;
+    the friction record for the next step (points moved by the mean step displacement)."""
+    cs = problem.contact
+    pairs = []
+    sim.friction = {}
+    for k, g in enumerate(cs.pairs):
+        s = cs.committed[k]
+        active = s["state"] != 0
+        w = g.weights
+        pn, pt = -s["tau_n"], s["tau_t"]
+        order = np.argsort(g.points[:, 0])
+        xl, xr = zone_ends(g.points[order, 0], active[order], s["g_n"][order])
+        wa = w[active]
+        f = traction_resultant(g, s, "j")[0]  # on body j (the obstacle) from body i
+        pairs.append(
+            dict(
+                fx=float(f[0]),
+                fy=float(f[1]),
+                body_i=keys[k][0],
+                body_j=keys[k][1],
+                x=float(np.average(g.points[active, 0], weights=wa)) if active.any() else 0.0,
+                y=float(np.average(g.points[active, 1], weights=wa)) if active.any() else 0.0,
+                normal_force=float(np.sum(w * pn)),
+                tangential_force=float(np.sum(w * pt)),
+                active_length=float(np.sum(wa)),
+                stick_fraction=float(np.sum(w[s["state"] == 1]) / np.sum(wa))
+                if active.any()
+                else 0.0,
+                half_width=0.0 if xl is None else 0.5 * (xr - xl),
+                num_points=int(len(w)),
+            )
+        )
+        if cs.mu > 0:
+            sim.friction[keys[k]] = (g.points.copy(), cs.elastic_slip(k))
+    # each pair lives on one rank: share the records, in the order of one rank
+    gathered = sim.comm.allgather(list(zip(cs.index, pairs)))
+    pairs = [p for _, p in sorted((q for lst in gathered for q in lst), key=lambda q: q[0])]
+    sim.friction = {k: v for d in sim.comm.allgather(sim.friction) for k, v in d.items()}
+    # contact resultants on each body: +sum w (tau_n n + tau_t t) on side i, the opposite on
+    # side j; moment about the body's material-point centroid
+    forces = {b.name: np.zeros(3) for b in sim.bodies}
+    for k, g in enumerate(cs.pairs):
+        s = cs.committed[k]
+        for side, name, p in (("i", keys[k][0], g.p_i), ("j", keys[k][1], g.p_j)):
+            if name in forces:
+                b = next(b for b in sim.bodies if b.name == name)
+                c = np.average(sim.points[b.tag].x, axis=0, weights=sim.points[b.tag].vol)
+                F, M = traction_resultant(g, s, side, p, c)
+                forces[name] += np.array([F[0], F[1], M])
+    body_forces = {
+        n: allreduce_array(sim.comm, v, MPI.SUM).tolist() for n, v in forces.items()
+    }
+    res = cs.obstacle_resultants()
+    obstacles = {}
+    for ob in sim.obstacles:
+        F, M = res[ob.name]
+        F = allreduce_array(sim.comm, np.asarray(F, float), MPI.SUM)
+        obstacles[ob.name] = dict(
+            fx=float(F[0]), fy=float(F[1]), moment=sim.comm.allreduce(M, op=MPI.SUM)
+        )
+    return dict(pairs=pairs, obstacles=obstacles, body_forces=body_forces)
