@@ -79,7 +79,13 @@ class DemoParser(argparse.ArgumentParser):
             check_discretization(self, a)
         if getattr(self, "_petsc_dest", None) is not None:  # add_petsc: KEY=VALUE -> dict
             # the trial solve reads the options on top of the chosen solver's defaults
-            base = ITERATIVE_DEFAULTS if getattr(a, "linear_solver", "") == "iterative" else None
+            solver = getattr(a, "linear_solver", "auto")
+            if solver == "condensed" and getattr(a, self._petsc_dest):
+                self.error(
+                    "--petsc: the condensed linear solver takes no PETSc options (it factorises "
+                    "the bulk with MUMPS itself); give --linear-solver factorised or iterative"
+                )
+            base = ITERATIVE_DEFAULTS if solver == "iterative" else None
             opts = petsc_options(self, getattr(a, self._petsc_dest), base)
             setattr(a, self._petsc_dest, opts)
         given = sys.argv[1:] if args is None else args
@@ -202,7 +208,6 @@ def petsc_options(parser, items, defaults=None):
     """Parse repeated --petsc KEY=VALUE into a dict (keys without the leading dash); a dict
     (already parsed, see add_petsc) is returned as it is. defaults: the solver's options that
     they override in the trial solve (default SOLVER_DEFAULTS)."""
-    defaults = SOLVER_DEFAULTS if defaults is None else defaults
     if isinstance(items, dict):
         return items
     opts = {}
@@ -212,32 +217,50 @@ def petsc_options(parser, items, defaults=None):
         if not sep or not key:
             parser.error(f"--petsc: expected KEY=VALUE, got {item!r}")
         opts[key] = value
+    why = check_petsc(opts, defaults)
+    if why is not None:
+        parser.error(f"--petsc: {why}")
+    return opts
+
+
+def check_petsc(opts, defaults=None, linear_solver="auto"):
+    """Why PETSc options `opts` cannot be used with the linear solver (None: they can): one
+    PETSc refuses (an unknown type, a value of the wrong kind), a trial solve with them fails,
+    or the solver does not read one (a misspelled key, or one without effect); the condensed
+    solver takes none (it factorises the bulk itself). The demos' --petsc and a scene's
+    solver.petsc are checked here alike."""
+    defaults = SOLVER_DEFAULTS if defaults is None else defaults
+    if opts and linear_solver == "condensed":
+        return (
+            "the condensed linear solver takes no PETSc options (it factorises the bulk with "
+            "MUMPS itself); give linear solver 'factorised' or 'iterative' with them"
+        )
     keys = list(opts)
     for n in range(1, len(keys) + 1):  # the first option PETSc refuses, with those before it
         ierr = petsc_refuses({k: opts[k] for k in keys[:n]})
         if ierr is not None:
             k = keys[n - 1]
-            parser.error(
-                f"--petsc: PETSc refuses {k}={opts[k]} (error {ierr}: an unknown type "
-                "or a value of the wrong kind)"
+            return (
+                f"PETSc refuses {k}={opts[k]} (error {ierr}: an unknown type or a value of "
+                "the wrong kind)"
             )
-    if opts:
-        ierr, unread = petsc_trial(opts, defaults)
-        every = {**defaults, **opts}
-        given = ", ".join(f"{k}={v}" for k, v in opts.items())
-        if ierr is not None:
-            parser.error(
-                f"--petsc: a trial solve with {given} fails (PETSc error {ierr}: "
-                "an option of the wrong kind for this solver)"
-            )
-        if unread:
-            k = unread[0]
-            parser.error(
-                f"--petsc: the linear solver does not read {k}={opts[k]} (an unknown or "
-                f"misspelled key, or one without effect with ksp_type={every['ksp_type']}, "
-                f"pc_type={every['pc_type']})"
-            )
-    return opts
+    if not opts:
+        return None
+    ierr, unread = petsc_trial(opts, defaults)
+    every = {**defaults, **opts}
+    given = ", ".join(f"{k}={v}" for k, v in opts.items())
+    if ierr is not None:
+        return (
+            f"a trial solve with {given} fails (PETSc error {ierr}: an option of the wrong kind "
+            "for this solver)"
+        )
+    if unread:
+        k = unread[0]
+        return (
+            f"the linear solver does not read {k}={opts[k]} (an unknown or misspelled key, or "
+            f"one without effect with ksp_type={every['ksp_type']}, pc_type={every['pc_type']})"
+        )
+    return None
 
 
 def petsc_refuses(opts):

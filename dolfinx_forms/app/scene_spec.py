@@ -369,6 +369,13 @@ def _solver(t):
         if isinstance(v, (dict, list)):
             raise SpecError(petsc.path(k), f"must be a string or a number, got {v!r}")
         s["petsc"][k] = str(v).lower() if isinstance(v, bool) else str(v)
+    if s["petsc"] or s["linear_solver"] == "condensed":  # checked as the demos' --petsc
+        from dolfinx_forms.app.cli import ITERATIVE_DEFAULTS, check_petsc
+
+        base = ITERATIVE_DEFAULTS if s["linear_solver"] == "iterative" else None
+        why = check_petsc(s["petsc"], base, s["linear_solver"])
+        if why is not None:
+            raise SpecError(t.path("petsc"), why)
     newton = t.table("newton", {})
     s["newton"] = {
         k: newton.number(k, None, lo=0, lo_open=True) for k in ("rtol", "ftol", "atol", "stol")

@@ -59,3 +59,18 @@ def test_binary_file_is_one_line(tmp_path):
     with pytest.raises(SpecError, match="not a UTF-8 text file") as e:
         load(bad)
     assert "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize(
+    "sets, why",
+    [
+        (['solver.petsc={ksp_type="bogus"}'], "PETSc refuses ksp_type=bogus"),
+        (['solver.petsc={ksp_rtol="1e-10"}'], "does not read ksp_rtol"),
+        (['solver.linear_solver="condensed"', 'solver.petsc={ksp_type="cg"}'], "condensed"),
+    ],
+)
+def test_scene_petsc_options_checked_as_the_demos(sets, why):
+    """solver.petsc is checked by the demos' check (cli.check_petsc), at validation."""
+    with pytest.raises(SpecError, match="^solver.petsc: ") as e:
+        load(SCENE, sets)
+    assert why in str(e.value)

@@ -164,6 +164,14 @@ CASES = [
     ("inclined_interface", "--petsc pc_type=nonsense", "--petsc"),  # bad value
     ("grain_assembly", "--petsc ksp_type=bogus", "--petsc"),
     ("brazilian_disc", "--petsc mat_mumps_icntl_14=abc", "--petsc"),
+    # the condensed solver factorises the bulk itself: no PETSc options (was a traceback)
+    ("hertz", "--linear-solver condensed --petsc ksp_type=cg", "--petsc"),
+    ("brazilian_disc", "--linear-solver condensed --petsc ksp_type=cg", "--petsc"),
+    ("four_grains", "--linear-solver condensed --petsc pc_type=lu", "--petsc"),
+    ("nine_discs", "--linear-solver condensed --petsc ksp_type=cg", "--petsc"),
+    # ------------------------------------------------ --out too long for the file system
+    ("patch_test", "--out {d}/" + "a" * 300, "--out"),
+    ("hertz", "--out {d}/" + "b" * 240, "--out"),
     # ------------------------------------------------ --out
     ("patch_test", "--out .", "--out"),
     ("hertz", "--out . --force", "--out"),
