@@ -727,6 +727,9 @@ def validate(data, base_dir=None, default_name="scene"):
     spec["analytic"] = None if an is None else _analytic(an, bodies, pairs, bnames)
     spec["checks"] = [_check(c) for c in top.tables("checks")]
     top.done()
+    from dolfinx_forms.app import scene_geometry
+
+    scene_geometry.check(spec)  # polygons, overlaps, the grid's extent, h against the bodies
     return spec
 
 

@@ -88,7 +88,7 @@ def shape_of(shape, window=None, size=1e6):
     return sd, bbox
 
 
-def _frames(spec):
+def body_shapes(spec):
     """Per body: (shape, bbox), errors keyed by the body."""
     size = 100 * max(_scale(spec), 1.0)
     out = []
@@ -223,7 +223,7 @@ def _cut_scene(comm, spec):
     from dolfinx_forms.mesh.cut_scene import CutBody, cut_scene
 
     d = spec["discretization"]
-    frames = _frames(spec)
+    frames = body_shapes(spec)
     explicit = [b["window"] for b in spec["bodies"] if b["window"] is not None]
     xl, yl = _grid_lines(d, explicit)
     tol = 1e-9 * max(xl[-1] - xl[0], yl[-1] - yl[0])
@@ -323,7 +323,7 @@ def _fitted_scene(comm, spec):
 
     d = spec["discretization"]
     h, quads = d["h"], d["cell"] == "quadrilateral"
-    frames = _frames(spec)
+    frames = body_shapes(spec)
     bodies = []
     for i, (b, (sd, bbox)) in enumerate(zip(spec["bodies"], frames)):
         if b["window"] is not None and b["shape"]["type"] != "half_plane":

@@ -74,3 +74,36 @@ def test_scene_petsc_options_checked_as_the_demos(sets, why):
     with pytest.raises(SpecError, match="^solver.petsc: ") as e:
         load(SCENE, sets)
     assert why in str(e.value)
+
+
+PATCH = ROOT / "demos" / "scenes" / "patch.toml"
+
+
+@pytest.mark.parametrize(
+    "scene, sets, key, why",
+    [
+        # h larger than the bodies: the reaction came out 3x small with exit 0
+        (PATCH, ["discretization.h=2.0"], "discretization.h", "body 'lower' is 0.5375 across"),
+        # the upper block pushed 1 mm into the lower one: reactions 12-28x, exit 0
+        (SCENE, ["bodies[1].shape.min=[10.0, 9.0]"], "bodies[1]", "'lower' and 'upper' overlap"),
+        # identical bodies
+        (SCENE, ['bodies[1].shape={type="box", min=[0.0, 0.0], max=[40.0, 10.0]}'], "bodies[1]",
+         "overlap"),
+        # a body partly outside the cut grid: clipped silently
+        (SCENE, ["bodies[1].shape.max=[30.0, 25.0]"], "bodies[1]", "partly outside the grid"),
+        # a self-intersecting polygon (a bow tie)
+        (SCENE, ['bodies[1].shape={type="polygon", points=[[10,10],[30,20],[30,10],[10,20]]}'],
+         "bodies[1].shape.points", "crosses itself (edges 0 and 2)"),
+    ],
+)  # fmt: skip
+def test_scene_geometry_refused_naming_the_body(scene, sets, key, why):
+    with pytest.raises(SpecError) as e:
+        load(scene, sets)
+    assert str(e.value).startswith(f"{key}: ") and why in str(e.value)
+
+
+def test_touching_bodies_are_not_an_overlap():
+    """The demos' scenes: bodies that touch along a side (two blocks, the patch) or at a
+    point (Hertz) pass."""
+    for name in ("two_blocks", "patch", "hertz", "mindlin", "disc_squeeze"):
+        assert load(ROOT / "demos" / "scenes" / f"{name}.toml")["name"] == name
