@@ -111,6 +111,20 @@ TEST(CellContour, CutCellClippingUsesTheContour) {
   EXPECT_GT(saddles, 200);
 }
 
+TEST(ContactRegion, MinLevelsetIsTheNodewiseMinimumOfEq21) {
+  // phi_min = min(phi_i, phi_j) at every node, exactly; grids that differ are refused
+  const StructuredGrid g = StructuredGrid::uniform({-2, -1}, {2, 1}, {40, 20});
+  const LevelSet a = levelset_from_shape(g, Circle({-0.55, 0}, 0.5));
+  const LevelSet b = levelset_from_shape(g, Circle({0.55, 0}, 0.5));
+  const LevelSet m = min_levelset(a, b);
+  ASSERT_EQ(m.values().size(), a.values().size());
+  for (std::size_t k = 0; k < m.values().size(); ++k)
+    EXPECT_EQ(m.values()[k], std::min(a.values()[k], b.values()[k])) << k;
+  const StructuredGrid other = StructuredGrid::uniform({-2, -1}, {2, 1}, {41, 20});
+  EXPECT_THROW(min_levelset(a, levelset_from_shape(other, Circle({0, 0}, 0.5))),
+               std::invalid_argument);
+}
+
 TEST(ContactRegion, IndicatorIsTheSetOfEq22) {
   // r < 0 exactly on {phi_i >= 0, phi_j >= 0, psi < 0} U {phi_i < 0, phi_j < 0}
   const double v[5] = {-1.0, -1e-300, 0.0, 1e-300, 2.0};

@@ -2,7 +2,7 @@
 
 eps_n = eps_t = eps0 h / E_c: h the contact mesh size, E_c = `contact_modulus`, the most
 compliant contact's modulus. The penalty uses it with the user's eps0; the augmented
-Lagrangian's point-wise regularisation with its own factors (`solvers.problem`'s defaults),
+Lagrangian's point-wise regularisation with its own factors (`defaults.TUNING`),
 the user's eps0 then only setting the Uzawa step.
 
 Why the contact's modulus and not the mean of the bodies' moduli (the scale the penalty path
