@@ -11,7 +11,7 @@ JOBS    ?= 2
 APT_PACKAGES := cmake make gcc g++ python3-sympy python3-dolfinx libdolfinx-dev python3-gmsh gmsh \
 	libeigen3-dev python3-mpi4py python3-meshio pybind11-dev python3-pytest \
 	python3-scipy python3-matplotlib libgtest-dev libbenchmark-dev python3-setuptools \
-	python3-venv openmpi-bin libnanoflann-dev libopenblas0-pthread
+	python3-venv openmpi-bin libnanoflann-dev libopenblas0-pthread python3-h5py
 # only `make bench` installs these: benchmarks/work_precision.py compares with GetFEM's nodal P1
 BENCH_PACKAGES := python3-getfem
 export OMPI_ALLOW_RUN_AS_ROOT := 1

@@ -57,18 +57,68 @@ def write_columns(path, **columns):
 
 
 def write_fields(folder, problem, name="solution"):
-    """Displacement (P1) and Cauchy stress (cellwise constant) in XDMF for ParaView."""
+    """<name>.xdmf + <name>.h5: ONE uniform grid (the mesh) with every field of the run, so
+    that ParaView and meshio (`meshio.read`) both open it: displacement (P1, node), each
+    body's level set `levelset_<body>` (its exact signed distance at the nodes, < 0 inside),
+    the Cauchy stress (the laws' own, cellwise constant), the body tag `body` and, on a cut
+    scene, `cut` (1: a cut cell, 0: interior) per cell. Paths inside are relative to the
+    .xdmf file. Collective."""
     from dolfinx import fem, io
 
-    mesh = problem.mesh
+    mesh, scene = problem.mesh, problem.scene
     V1 = fem.VectorFunctionSpace(mesh, ("Lagrange", 1))
     u1 = fem.Function(V1, name="displacement")
     u1.interpolate(problem.u)
-    sig = problem.stress(("DG", 0))  # the laws' own output stress
-    with io.XDMFFile(mesh.comm, str(Path(folder) / f"{name}.xdmf"), "w") as f:
+    fields = [u1]
+    S1 = fem.FunctionSpace(mesh, ("Lagrange", 1))
+    x = S1.tabulate_dof_coordinates()[:, :2]
+    for b in scene.bodies:
+        phi = fem.Function(S1, name=f"levelset_{b.name}")
+        phi.x.array[:] = np.asarray(b.shape(np.ascontiguousarray(x)), dtype=float)
+        fields.append(phi)
+    fields.append(problem.stress(("DG", 0)))  # the laws' own output stress
+    fields.append(_cell_field(mesh, scene.cell_tags, "body"))
+    if getattr(scene, "cut", None) is not None:
+        fields.append(_cell_field(mesh, scene.cut.kind_tags, "cut"))
+    path = Path(folder) / f"{name}.xdmf"
+    with io.XDMFFile(mesh.comm, str(path), "w") as f:
         f.write_mesh(mesh)
-        f.write_function(u1)
-        f.write_function(sig)
+        for field in fields:
+            f.write_function(field)
+    if mesh.comm.rank == 0:
+        one_grid(path)
+    mesh.comm.barrier()
+
+
+def _cell_field(mesh, tags, name):
+    """A DG0 function of the values of cell tags `tags` (-1 where a cell has none)."""
+    from dolfinx import fem
+
+    V0 = fem.FunctionSpace(mesh, ("DG", 0))
+    f = fem.Function(V0, name=name)
+    f.x.array[:] = -1.0
+    dofs = V0.dofmap.list.array.reshape(-1)  # one dof per cell
+    f.x.array[dofs[tags.indices]] = tags.values
+    return f
+
+
+def one_grid(path):
+    """Rewrite the XDMF file DOLFINx wrote (the mesh, then one temporal collection per
+    function) as one uniform grid carrying every function as an attribute: meshio reads one
+    grid only ("Only supports one grid", then it exits), ParaView reads both."""
+    import xml.etree.ElementTree as ET
+
+    tree = ET.parse(path)
+    domain = tree.getroot().find("Domain")
+    grids = domain.findall("Grid")
+    mesh = grids[0]
+    for g in grids[1:]:
+        for a in g.iter("Attribute"):
+            mesh.append(a)
+        domain.remove(g)
+    mesh.set("Name", "solution")
+    ET.indent(tree)
+    tree.write(path, xml_declaration=True, encoding="unicode")
 
 
 def plot_tractions(path, pts, analytic=None, title="", xlabel="x (mm)", ylabel="traction (MPa)"):
