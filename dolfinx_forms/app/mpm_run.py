@@ -6,8 +6,8 @@ tangential_force, active_length, stick_fraction), `bodies.csv` (step, body, fx, 
 area_levelset, volume_points), and two XDMF time series that ParaView opens:
 `material_points.xdmf` (the points at their current positions with stress, volume and
 displacement since the start) and `levelsets.xdmf` (the background grid with each body's level
-set and extended step displacement). The series store raw little-endian float64 files beside the
-.xdmf (XDMF "Binary" items; no HDF5 needed), one frame every `series_every` steps.
+set and extended step displacement). Each series keeps its arrays in one HDF5 file beside the
+.xdmf (`Series`), one frame every `series_every` steps.
 
 `Steps` is the step loop of a multi-step demo inside the run skeleton every demo uses
 (`demo.Run`): records, warnings, series frames, the metrics blocks and the step files.
@@ -37,7 +37,11 @@ BODY_COLUMNS = ["step", "body", "fx", "fy", "moment", "area_levelset", "volume_p
 
 
 class Series:
-    """An XDMF temporal collection of frames, each with its own geometry (module docstring)."""
+    """An XDMF temporal collection of frames, each with its own geometry, all its arrays in
+    one HDF5 file beside it (<name>.h5, paths relative to the .xdmf); ParaView and meshio's
+    TimeSeriesReader open it. A cloud of points is a Polyvertex grid whose every point is a
+    cell; each frame also carries its points as the field `position` (meshio's reader keeps
+    the first frame's geometry)."""
 
     def __init__(self, name):
         self.name, self.frames = name, []
@@ -48,37 +52,45 @@ class Series:
         self.frames.append((float(time_value), np.asarray(points, float), point_data, cells))
 
     def write(self, folder):
+        import h5py
+
         folder = Path(folder)
         grids = []
-        for k, (t, x, data, cells) in enumerate(self.frames):
-            n = len(x)
-            xyz = np.zeros((n, 3))
-            xyz[:, : x.shape[1]] = x
-            items = [self._blob(folder, f"{k}_geometry", xyz)]
-            if cells is None:
-                topo = f'<Topology TopologyType="Polyvertex" NumberOfElements="{n}" />'
-            else:
-                vtk = np.ascontiguousarray(np.asarray(cells)[:, [0, 1, 3, 2]], dtype=np.int64)
-                topo = (
-                    f'<Topology TopologyType="Quadrilateral" NumberOfElements="{len(vtk)}">'
-                    + self._item(folder, f"{k}_topology", vtk)
-                    + "</Topology>"
+        with h5py.File(folder / f"{self.name}.h5", "w") as h5:
+            for k, (t, x, data, cells) in enumerate(self.frames):
+                n = len(x)
+                xyz = np.zeros((n, 3))
+                xyz[:, : x.shape[1]] = x
+                if cells is None:
+                    kind, topo = "Polyvertex", np.arange(n, dtype=np.int64)[:, None]
+                    data = {"position": xyz, **data}
+                else:
+                    kind = "Quadrilateral"
+                    topo = np.asarray(cells)[:, [0, 1, 3, 2]].astype(np.int64)  # VTK order
+                nodes = "" if cells is not None else ' NodesPerElement="1"'
+                parts = [
+                    f'<Topology TopologyType="{kind}" NumberOfElements="{len(topo)}"{nodes}>'
+                    + self._item(h5, f"frame{k}/topology", topo)
+                    + "</Topology>",
+                    '<Geometry GeometryType="XYZ">'
+                    + self._item(h5, f"frame{k}/geometry", xyz)
+                    + "</Geometry>",
+                ]
+                for name, v in data.items():
+                    v = np.asarray(v, float)
+                    kind_a = "Scalar" if v.ndim == 1 else "Vector" if v.shape[1] <= 3 else "Tensor"
+                    if kind_a == "Vector" and v.shape[1] == 2:
+                        v = np.hstack([v, np.zeros((n, 1))])
+                    parts.append(
+                        f'<Attribute Name="{name}" AttributeType="{kind_a}" Center="Node">'
+                        + self._item(h5, f"frame{k}/{name}", v)
+                        + "</Attribute>"
+                    )
+                grids.append(
+                    f'<Grid Name="frame{k}" GridType="Uniform"><Time Value="{t:.17g}" />'
+                    + "".join(parts)
+                    + "</Grid>"
                 )
-            attrs = []
-            for name, v in data.items():
-                v = np.asarray(v, float)
-                kind = "Scalar" if v.ndim == 1 else "Vector" if v.shape[1] <= 3 else "Tensor"
-                if kind == "Vector" and v.shape[1] == 2:
-                    v = np.hstack([v, np.zeros((n, 1))])
-                attrs.append(
-                    f'<Attribute Name="{name}" AttributeType="{kind}" Center="Node">'
-                    + self._item(folder, f"{k}_{name}", v)
-                    + "</Attribute>"
-                )
-            grids.append(
-                f'<Grid Name="frame{k}" GridType="Uniform"><Time Value="{t:.17g}" />{topo}'
-                f'<Geometry GeometryType="XYZ">{items[0]}</Geometry>{"".join(attrs)}</Grid>'
-            )
         text = (
             '<?xml version="1.0"?>\n<Xdmf Version="3.0"><Domain>'
             f'<Grid Name="{self.name}" GridType="Collection" CollectionType="Temporal">'
@@ -87,18 +99,14 @@ class Series:
         )
         (folder / f"{self.name}.xdmf").write_text(text)
 
-    def _blob(self, folder, key, a):
-        return self._item(folder, key, a)
-
-    def _item(self, folder, key, a):
+    def _item(self, h5, key, a):
         a = np.ascontiguousarray(a)
-        fname = f"{self.name}_{key}.bin"
-        a.astype(a.dtype.newbyteorder("<")).tofile(folder / fname)
-        dtype, prec = ("Int", 8) if a.dtype.kind == "i" else ("Float", 8)
+        h5.create_dataset(key, data=a)
+        dtype = "Int" if a.dtype.kind == "i" else "Float"
         dims = " ".join(str(d) for d in a.shape)
         return (
-            f'<DataItem Dimensions="{dims}" NumberType="{dtype}" Precision="{prec}" '
-            f'Format="Binary" Endian="Little">{fname}</DataItem>'
+            f'<DataItem Dimensions="{dims}" NumberType="{dtype}" Precision="8" '
+            f'Format="HDF">{self.name}.h5:/{key}</DataItem>'
         )
 
 

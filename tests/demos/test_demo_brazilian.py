@@ -60,17 +60,32 @@ def test_bad_input_exits_2_naming_the_parameter(args, word, tmp_path, capsys):
     assert not (tmp_path / "x").exists()
 
 
-def test_time_series_reference_their_data(tmp_path):
-    """The XDMF series are well-formed and every Binary item names a file of its size."""
-    import xml.etree.ElementTree as ET
+def test_time_series_read_by_meshio_and_h5py(tmp_path):
+    """One HDF5 file per series, paths relative to the .xdmf; meshio's TimeSeriesReader reads
+    every frame, and its values are the run's: the points' positions are the seeded points
+    moved by their displacement, and the last frame's volumes sum to the points' volume of
+    steps.csv (issue 29, item 5)."""
+    import h5py
+    import meshio
 
     out = tmp_path / "bd"
     assert demo.main(["--h", "1", "--steps", "2", "--series-every", "1", "--out", str(out)]) == 0
-    for name in ("material_points_disc.xdmf", "levelsets.xdmf"):
-        root = ET.parse(out / name).getroot()
-        frames = root.findall(".//Grid[@GridType='Uniform']")
-        assert len(frames) == 2
-        for item in root.iter("DataItem"):
-            dims = [int(d) for d in item.get("Dimensions").split()]
-            size = (out / item.text).stat().st_size
-            assert size == 8 * int(np.prod(dims)), item.text
+    assert sorted(p.name for p in out.glob("*.h5")) == ["levelsets.h5", "material_points_disc.h5"]
+    assert not list(out.glob("*.bin"))
+    rows = list(csv.DictReader(open(out / "steps.csv")))
+    with meshio.xdmf.TimeSeriesReader(out / "material_points_disc.xdmf") as r:
+        points, cells = r.read_points_cells()
+        assert r.num_steps == 2 and cells[0].type == "vertex"
+        first = r.read_data(0)[1]
+        t, data, _ = r.read_data(1)
+    assert t == 2.0
+    assert np.allclose(first["position"], points)  # frame 0's geometry is its positions
+    volume = float(rows[-1]["volume_points"])
+    assert data["volume"].sum() == pytest.approx(volume, rel=1e-12)
+    with h5py.File(out / "material_points_disc.h5", "r") as f:
+        assert np.array_equal(f["frame1/position"][()], data["position"])
+    with meshio.xdmf.TimeSeriesReader(out / "levelsets.xdmf") as r:
+        grid, cells = r.read_points_cells()
+        assert cells[0].type == "quad" and r.num_steps == 2
+        phi = r.read_data(1)[1]["phi_disc"]
+    assert phi.shape == (len(grid),) and phi.min() < 0 < phi.max()
