@@ -1,6 +1,7 @@
 // Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
 #include "reinit.h"
 #include "projection.h"
+#include "shapes.h"
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -42,19 +43,6 @@ inline int upwind_pair(double am, double hm, double ap, double hp, double* a, do
   }
   a[0] = am, h[0] = hm, a[1] = ap, h[1] = hp;
   return 2;
-}
-
-/// Distance from (px, py) to segment [a, b]; exactly 0 for a point on an
-/// axis-aligned (or otherwise exactly collinear) segment.
-inline double segment_distance(double px, double py, double ax, double ay, double bx, double by) {
-  const double ex = bx - ax, ey = by - ay;
-  const double wx = px - ax, wy = py - ay;
-  const double l2 = ex * ex + ey * ey;
-  const double t = l2 > 0 ? std::clamp((wx * ex + wy * ey) / l2, 0.0, 1.0) : 0.0;
-  const double cross = wx * ey - wy * ex;
-  if (cross == 0 and t > 0 and t < 1)
-    return 0.0;
-  return std::hypot(wx - t * ex, wy - t * ey);
 }
 
 /// Physical width of `band` cells around node i of an axis: a point closer than
@@ -288,7 +276,7 @@ LevelSet contact::levelset_from_polyline(const StructuredGrid& grid,
     for (std::size_t j = jlo; j <= jhi; ++j)
       for (std::size_t i = ilo; i <= ihi; ++i) {
         double& dk = d[grid.node(i, j)];
-        dk = std::min(dk, segment_distance(x[i], y[j], ax, ay, bx, by));
+        dk = std::min(dk, segment_distance({x[i], y[j]}, {ax, ay}, {bx, by}));
       }
   }
 

@@ -136,6 +136,8 @@ double contact::segment_distance(std::array<double, 2> x, std::array<double, 2> 
   const double wx = x[0] - a[0], wy = x[1] - a[1];
   const double l2 = ex * ex + ey * ey;
   const double t = l2 > 0 ? std::clamp((wx * ex + wy * ey) / l2, 0.0, 1.0) : 0.0;
+  if (wx * ey - wy * ex == 0 and t > 0 and t < 1)
+    return 0.0;
   return std::hypot(wx - t * ex, wy - t * ey);
 }
 

@@ -105,7 +105,9 @@ private:
 /// @brief Level set of a shape sampled at the grid nodes.
 LevelSet levelset_from_shape(const StructuredGrid& grid, const Shape& shape);
 
-/// @brief Unsigned distance from x to the segment [a, b].
+/// @brief Unsigned distance from x to the segment [a, b]: the one definition (polygons,
+/// polyline reinitialisation); exactly 0 for a point on the segment that is exactly
+/// collinear with it (a grid node on an axis-aligned edge: no round-off sign).
 double segment_distance(std::array<double, 2> x, std::array<double, 2> a, std::array<double, 2> b);
 
 } // namespace contact
