@@ -624,11 +624,55 @@ def pair_geometry(
     i, j = pair
     bi = scene.bodies[i]
     bj = scene.bodies[j] if obstacle is None else obstacle
-    h = scene.h_contact
-    dx = h / grid_refine
+    dx = scene.h_contact / grid_refine
+    grid, box = pair_grid(bi, bj, band, dx, lattice_origin)
+    if grid is None:
+        return None
+    phi_i, phi_j = body_levelset(grid, bi), body_levelset(grid, bj)
+    s = _cpp.contact_surface(phi_i, phi_j, 0.5 * band, num_gauss)
+    # Gamma_c through level-set grid nodes leaves zero-length segments: drop their points
+    keep = s["weights"] > 1e-9 * dx
+    s = {
+        k: (v[keep] if isinstance(v, np.ndarray) and len(v) == len(keep) else v)
+        for k, v in s.items()
+    }
+    if len(s["weights"]) == 0:
+        return None
+    sides = _Sides(V, scene, bi, bj, obstacle, phi_i, phi_j, projection, max_outside, dx)
+    mult = (None, None)
+    if multipliers is not None:
+        length = scene.h_contact if multiplier_length is None else multiplier_length
+        s = mortar_quadrature(s, sides, length, num_gauss)
+        mult = multiplier_nodes(s, multipliers, length, 1e-10 * dx)
+    p_i, p_j, q = sides.quadrature(s)
+    if mult[0] is not None and traction == "nodes":
+        q.set_multiplier_nodes(*mult)
+    return PairGeometry(
+        pair,
+        s["points"],
+        s["weights"],
+        s["normals"],
+        s["tangents"],
+        p_i,
+        p_j,
+        sides.g_n0,
+        q,
+        dx,
+        box,
+        obstacle,
+        *mult,
+        traction,
+        multiplier_mass,
+    )
+
+
+def pair_grid(bi, bj, band, dx, lattice_origin=None):
+    """(the pair's level-set grid of spacing dx over the search box, the box), or (None,
+    None) when the bodies' inflated boxes are disjoint. A grid level set is known on its
+    own grid only: the pair grid stays inside it (ValueError if it cannot cover the overlap)."""
     box = search_box(bi, bj, band + 4 * dx)
     if box is None:
-        return None
+        return None, None
     if all(isinstance(b, RigidObstacle) or has_exact_shape(b) for b in (bi, bj)):
         box = near_box(box, bi, bj, band + 4 * dx, 8 * dx, dx)
     if lattice_origin is not None:
@@ -659,156 +703,145 @@ def pair_geometry(
     grid = _cpp.StructuredGrid(
         np.linspace(box[0, 0], hi[0], n[0] + 1), np.linspace(box[0, 1], hi[1], n[1] + 1)
     )
-    phi_i, phi_j = body_levelset(grid, bi), body_levelset(grid, bj)
-    s = _cpp.contact_surface(phi_i, phi_j, 0.5 * band, num_gauss)
-    # Gamma_c through level-set grid nodes leaves zero-length segments: drop their points
-    keep = s["weights"] > 1e-9 * dx
-    s = {
-        k: (v[keep] if isinstance(v, np.ndarray) and len(v) == len(keep) else v)
-        for k, v in s.items()
-    }
-    if len(s["weights"]) == 0:
-        return None
-    degree = V.ufl_element().degree()
-    dofmap = V.dofmap.list.array.reshape(-1, V.dofmap.dof_layout.num_dofs)
-    max_outside = 0.5 * h if max_outside is None else max_outside
-    cut = getattr(scene, "cut", None)
-    locators = [
-        None  # rigid side: no dofs, its motion is prescribed (u_j_prescribed)
-        if body is obstacle
-        else (
-            GridLocator(scene.mesh, scene.cell_tags, body.tag, cut, degree)
-            if cut is not None  # structured grid: O(1) location by index
-            else BodyLocator(scene.mesh, scene.cell_tags, body.tag, scene.cell_type, degree)
+    return grid, box
+
+
+class _Sides:
+    """The two sides of a pair on the DOLFINx mesh: closest points (eq 25), the cells that
+    hold them, and the contact quadrature's dofs and bases (a rigid obstacle: no dofs)."""
+
+    def __init__(self, V, scene, bi, bj, obstacle, phi_i, phi_j, projection, max_outside, dx):
+        self.bodies, self.phi = (bi, bj), (phi_i, phi_j)
+        self.h, self.dx, self.exact = scene.h_contact, dx, projection == "auto"
+        self.max_outside = 0.5 * self.h if max_outside is None else max_outside
+        self._phi_int = None
+        self.dofmap = V.dofmap.list.array.reshape(-1, V.dofmap.dof_layout.num_dofs)
+        degree, cut = V.ufl_element().degree(), getattr(scene, "cut", None)
+        self.locators = [
+            None  # rigid side: no dofs, its motion is prescribed (u_j_prescribed)
+            if body is obstacle
+            else (
+                GridLocator(scene.mesh, scene.cell_tags, body.tag, cut, degree)
+                if cut is not None  # structured grid: O(1) location by index
+                else BodyLocator(scene.mesh, scene.cell_tags, body.tag, scene.cell_type, degree)
+            )
+            for body in (bi, bj)
+        ]
+
+    @property
+    def phi_int(self):
+        """The intermediate level set (eq 23), made when the mortar splitting needs it."""
+        if self._phi_int is None:
+            self._phi_int = _cpp.intermediate_levelset(*self.phi)
+        return self._phi_int
+
+    def project_on(self, side, points, scale=None):
+        return closest_points(
+            self.bodies[side], self.phi[side], points, scale or self.h, exact=self.exact
         )
-        for body in (bi, bj)
-    ]
 
-    def project_on(side, points, scale=h):
-        b, phi = ((bi, phi_i), (bj, phi_j))[side]
-        return closest_points(b, phi, points, scale, exact=projection == "auto")
+    def project(self, points, scale=None):
+        return [self.project_on(side, points, scale) for side in (0, 1)]
 
-    def project(points, scale=h):
-        return [project_on(side, points, scale) for side in (0, 1)]
-
-    mult = (None, None)
-    if multipliers is not None:
-        length = h if multiplier_length is None else multiplier_length
-        tol = 1e-10 * dx  # shortest piece; chain ends join within it
-        # mortar-type integration: Gamma_c's pieces split at the multiplier elements' ends and
-        # where a closest point moves into another cell of its body, so that each piece
-        # integrates a smooth integrand (a hat times the traces of both bodies' bases): the
-        # contact terms are then exact for a flat interface on non-matching meshes
-        used = np.unique(s["segment"])
-        segs, cells = s["segments"][used], s["cells"][used]
-
-        phi_int = _cpp.intermediate_levelset(phi_i, phi_j)
-
-        def cell_label(side, points, proj):
-            loc = locators[side]
-            return (
-                np.zeros(len(points), np.int32)
-                if loc is None
-                else loc.cell_label(proj, max_outside)
-            )
-
-        def past_both(points, proj):
-            n = np.asarray(phi_int.evaluate(points)[1])
-            n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
-            return beyond_end(points, proj[0], n, 1e-9 * dx) & beyond_end(
-                points, proj[1], n, 1e-9 * dx
-            )
-
-        def labels(points):
-            """Per body the cell that holds the closest point; whether the point lies past the
-            ends of both bodies (`beyond_end`)."""
-            # exact shapes' gradients by differences of 1e-7 scale: fine enough near corners
-            proj = [pr["points"] for pr in project(points, 1e-3 * h)]
-            cells = [cell_label(side, points, p) for side, p in enumerate(proj)]
-            return np.stack(cells + [past_both(points, proj)], axis=1)
-
-        def label(points, col):
-            """labels(points)[i, col[i]]: a cell label needs one body's closest point only."""
-            out = np.empty(len(points), np.int64)
-            for c in np.unique(col):
-                at = np.flatnonzero(col == c)
-                if c == 2:
-                    proj = [pr["points"] for pr in project(points[at], 1e-3 * h)]
-                    out[at] = past_both(points[at], proj)
-                else:
-                    p = project_on(c, points[at], 1e-3 * h)["points"]
-                    out[at] = cell_label(c, points[at], p)
-            return out
-
-        # a piece (h / grid_refine) rarely holds more than one change; after the first round
-        # only the sub-pieces of the pieces just split can hold one (the others had none).
-        # Those are read 1e-3 dx inside their ends: the labels' closest points on a curved
-        # exact shape carry round-off up to ~1e-4 dx (gradients by differences of 1e-10 h; Hertz
-        # cylinder at h = a/20), so a change just cut keeps reappearing within that of the cut
-        # (pieces 1e-9 to 1e-4 dx long, of no weight, for all 6 rounds); a second change missed
-        # that close to an end costs O((1e-3 dx / h)^2) of that piece's integral.
-        check, inset = np.ones(len(segs), bool), 100 * tol
-        for _ in range(6):
-            piece, t = label_breaks(segs[check], labels, inset, label=label)
-            inset = 1e-3 * dx
-            if len(piece) == 0:
-                break
-            piece = np.flatnonzero(check)[piece]
-            segs, parent = split_segments(segs, np.arange(len(segs)), piece, t, tol)
-            cells, check = cells[parent], np.isin(parent, piece)
-        # where both bodies end (the corners of two blocks), so does Gamma_c: the closing
-        # level set's sign, which clipped it, is off by its reinitialisation error (~dx / 40)
-        if len(segs):
-            on = labels(0.5 * (segs[:, 0] + segs[:, 1]))[:, 2] == 0
-            segs, cells = segs[on], cells[on]
-        segs, cells = split_segments(segs, cells, *multiplier_breaks(segs, length, tol), tol)
-        s = _cpp.segment_quadrature(phi_int, segs, cells.astype(np.int32), num_gauss)
-        mult = multiplier_nodes(s, multipliers, length, tol)
-    proj = project(s["points"])
-    for name, pr in zip((bi.name, bj.name), proj):
-        if not np.all(pr["converged"]):
-            bad = np.flatnonzero(~pr["converged"])[0]
-            raise RuntimeError(
-                f"closest-point projection onto body {name!r} failed at contact point "
-                f"{s['points'][bad]} (status {_cpp.ProjectionStatus(int(pr['status'][bad])).name})"
-            )
-    p_i, p_j = proj[0]["points"], proj[1]["points"]
-    normals, tangents = s["normals"], s["tangents"]
-    zero = np.zeros_like(p_i)  # reference configuration: g_n = g_n0 (eq 28)
-    g_n0 = _cpp.compute_gaps(p_i, p_j, zero, zero, normals, tangents)["g_n0"]
-
-    sides = []
-    for body, p, loc in ((bi, p_i, locators[0]), (bj, p_j, locators[1])):
+    def cell_label(self, side, points, proj):
+        loc = self.locators[side]
         if loc is None:
-            sides.append((np.zeros((len(p), 0), np.int32), np.zeros((len(p), 0))))
-            continue
-        cells, X, outside = loc.locate(p, max_outside)
-        if np.any(cells < 0):
-            bad = np.flatnonzero(cells < 0)[0]
-            raise RuntimeError(
-                f"closest point {p[bad]} on body {body.name!r} is not within "
-                f"{max_outside:g} of any of its cells on this rank"
-            )
-        sides.append((dofmap[cells].astype(np.int32), loc.basis(X)))
-    q = _cpp.ContactQuadrature(
-        s["weights"], normals, tangents, g_n0, sides[0][0], sides[1][0], sides[0][1], sides[1][1]
-    )
-    if mult[0] is not None and traction == "nodes":
-        q.set_multiplier_nodes(*mult)
-    return PairGeometry(
-        pair,
-        s["points"],
-        s["weights"],
-        normals,
-        tangents,
-        p_i,
-        p_j,
-        g_n0,
-        q,
-        dx,
-        box,
-        obstacle,
-        *mult,
-        traction,
-        multiplier_mass,
-    )
+            return np.zeros(len(points), np.int32)
+        return loc.cell_label(proj, self.max_outside)
+
+    def past_both(self, points, proj):
+        n = np.asarray(self.phi_int.evaluate(points)[1])
+        n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+        tol = 1e-9 * self.dx
+        return beyond_end(points, proj[0], n, tol) & beyond_end(points, proj[1], n, tol)
+
+    def labels(self, points):
+        """Per body the cell that holds the closest point; whether the point lies past the
+        ends of both bodies (`beyond_end`)."""
+        # exact shapes' gradients by differences of 1e-7 scale: fine enough near corners
+        proj = [pr["points"] for pr in self.project(points, 1e-3 * self.h)]
+        cells = [self.cell_label(side, points, p) for side, p in enumerate(proj)]
+        return np.stack(cells + [self.past_both(points, proj)], axis=1)
+
+    def label(self, points, col):
+        """labels(points)[i, col[i]]: a cell label needs one body's closest point only."""
+        out = np.empty(len(points), np.int64)
+        for c in np.unique(col):
+            at = np.flatnonzero(col == c)
+            if c == 2:
+                proj = [pr["points"] for pr in self.project(points[at], 1e-3 * self.h)]
+                out[at] = self.past_both(points[at], proj)
+            else:
+                p = self.project_on(c, points[at], 1e-3 * self.h)["points"]
+                out[at] = self.cell_label(c, points[at], p)
+        return out
+
+    def quadrature(self, s):
+        """(p_i, p_j, the ContactQuadrature) of the contact points of `s`: closest points
+        (eq 25), initial gaps (eq 28), the dofs and bases at the closest points."""
+        proj = self.project(s["points"])
+        for body, pr in zip(self.bodies, proj):
+            if not np.all(pr["converged"]):
+                bad = np.flatnonzero(~pr["converged"])[0]
+                status = _cpp.ProjectionStatus(int(pr["status"][bad])).name
+                raise RuntimeError(
+                    f"closest-point projection onto body {body.name!r} failed at contact "
+                    f"point {s['points'][bad]} (status {status})"
+                )
+        p_i, p_j = proj[0]["points"], proj[1]["points"]
+        normals, tangents = s["normals"], s["tangents"]
+        zero = np.zeros_like(p_i)  # reference configuration: g_n = g_n0 (eq 28)
+        self.g_n0 = _cpp.compute_gaps(p_i, p_j, zero, zero, normals, tangents)["g_n0"]
+        sides = []
+        for body, p, loc in zip(self.bodies, (p_i, p_j), self.locators):
+            if loc is None:
+                sides.append((np.zeros((len(p), 0), np.int32), np.zeros((len(p), 0))))
+                continue
+            cells, X, outside = loc.locate(p, self.max_outside)
+            if np.any(cells < 0):
+                bad = np.flatnonzero(cells < 0)[0]
+                raise RuntimeError(
+                    f"closest point {p[bad]} on body {body.name!r} is not within "
+                    f"{self.max_outside:g} of any of its cells on this rank"
+                )
+            sides.append((self.dofmap[cells].astype(np.int32), loc.basis(X)))
+        q = _cpp.ContactQuadrature(
+            s["weights"], normals, tangents, self.g_n0, sides[0][0], sides[1][0], sides[0][1],
+            sides[1][1],
+        )  # fmt: skip
+        return p_i, p_j, q
+
+
+def mortar_quadrature(s, sides, length, num_gauss):
+    """Mortar-type integration of Gamma_c (`s`, from contact_surface): its pieces split at
+    the multiplier elements' ends (nodes `length` apart) and where a closest point moves into
+    another cell of its body, so that each piece integrates a smooth integrand (a hat times
+    the traces of both bodies' bases): the contact terms are then exact for a flat interface
+    on non-matching meshes. Returns the new segment quadrature."""
+    dx = sides.dx
+    tol = 1e-10 * dx  # shortest piece; chain ends join within it
+    used = np.unique(s["segment"])
+    segs, cells = s["segments"][used], s["cells"][used]
+    # a piece (h / grid_refine) rarely holds more than one change; after the first round
+    # only the sub-pieces of the pieces just split can hold one (the others had none).
+    # Those are read 1e-3 dx inside their ends: the labels' closest points on a curved
+    # exact shape carry round-off up to ~1e-4 dx (gradients by differences of 1e-10 h; Hertz
+    # cylinder at h = a/20), so a change just cut keeps reappearing within that of the cut
+    # (pieces 1e-9 to 1e-4 dx long, of no weight, for all 6 rounds); a second change missed
+    # that close to an end costs O((1e-3 dx / h)^2) of that piece's integral.
+    check, inset = np.ones(len(segs), bool), 100 * tol
+    for _ in range(6):
+        piece, t = label_breaks(segs[check], sides.labels, inset, label=sides.label)
+        inset = 1e-3 * dx
+        if len(piece) == 0:
+            break
+        piece = np.flatnonzero(check)[piece]
+        segs, parent = split_segments(segs, np.arange(len(segs)), piece, t, tol)
+        cells, check = cells[parent], np.isin(parent, piece)
+    # where both bodies end (the corners of two blocks), so does Gamma_c: the closing
+    # level set's sign, which clipped it, is off by its reinitialisation error (~dx / 40)
+    if len(segs):
+        on = sides.labels(0.5 * (segs[:, 0] + segs[:, 1]))[:, 2] == 0
+        segs, cells = segs[on], cells[on]
+    segs, cells = split_segments(segs, cells, *multiplier_breaks(segs, length, tol), tol)
+    return _cpp.segment_quadrature(sides.phi_int, segs, cells.astype(np.int32), num_gauss)
