@@ -584,23 +584,10 @@ def _check(t):
 
 
 # --------------------------------------------------------------------------- the description
-def validate(data, base_dir=None, default_name="scene"):
-    """Check a description (a dict, as read from TOML) and return a new dict with every
-    default filled in. Raises SpecError naming the first bad key."""
-    top = _Table(copy.deepcopy(data), "")
-    # a file's name gives the default, made plain ("my scene.toml": "my_scene")
-    default_name = re.sub(r"[^A-Za-z0-9_.-]", "_", default_name)[:100].strip(".") or "scene"
-    name = top.string("name", default_name)
-    if not NAME.fullmatch(name) or name in (".", ".."):
-        raise SpecError(
-            "name", f"a plain file name (letters, digits, '-', '_', '.'; at most 100), got {name!r}"
-        )
-    spec = {"name": name, "description": top.string("description", "")}
-    spec["discretization"] = _discretization(top.table("discretization"))
-    spec["solver"] = _solver(top.table("solver", {}))
-
+def _bodies(top, base_dir):
+    """{name: body} of the [[bodies]] tables: shape, law, window."""
     bodies = {}
-    for i, b in enumerate(top.tables("bodies")):
+    for b in top.tables("bodies"):
         name = b.string("name")
         if name in bodies:
             raise SpecError(b.path("name"), f"duplicate body name {name!r}")
@@ -615,9 +602,12 @@ def validate(data, base_dir=None, default_name="scene"):
         b.done()
     if not bodies:
         raise SpecError("bodies", "missing (at least one [[bodies]] table)")
-    names = list(bodies)
-    spec["bodies"] = list(bodies.values())
+    return bodies
 
+
+def _pairs(top, bodies):
+    """The [[pairs]] in contact (default: every two bodies)."""
+    names = list(bodies)
     pairs = []
     for p in top.tables("pairs"):
         v = p.raw("bodies")
@@ -632,8 +622,11 @@ def validate(data, base_dir=None, default_name="scene"):
         p.done()
     if not top.has("pairs"):
         pairs = [[a, b] for i, a in enumerate(names) for b in names[i + 1 :]]
-    spec["pairs"] = pairs
+    return pairs
 
+
+def _boundaries(top, names):
+    """{name: boundary} of the [[boundaries]]: a side of a body, or a box."""
     boundaries = {}
     for b in top.tables("boundaries"):
         name = b.string("name")
@@ -662,9 +655,12 @@ def validate(data, base_dir=None, default_name="scene"):
             box.done()
         boundaries[name] = bd
         b.done()
-    spec["boundaries"] = list(boundaries.values())
-    bnames = list(boundaries)
+    return boundaries
 
+
+def _loads(top, spec, names, bnames):
+    """spec's dirichlet, tractions and body_forces; returns ({load name: kind}, {name:
+    Dirichlet entry}) for the stages."""
     loads, dirichlet = {}, {}
 
     def add_load(t, entry, kind):
@@ -707,6 +703,32 @@ def validate(data, base_dir=None, default_name="scene"):
             }
             e["name"] = t.string("name", ref if ref is not None else f"{section}-{len(loads)}")
             spec[section].append(add_load(t, e, section))
+    return loads, dirichlet
+
+
+def validate(data, base_dir=None, default_name="scene"):
+    """Check a description (a dict, as read from TOML) and return a new dict with every
+    default filled in. Raises SpecError naming the first bad key."""
+    top = _Table(copy.deepcopy(data), "")
+    # a file's name gives the default, made plain ("my scene.toml": "my_scene")
+    default_name = re.sub(r"[^A-Za-z0-9_.-]", "_", default_name)[:100].strip(".") or "scene"
+    name = top.string("name", default_name)
+    if not NAME.fullmatch(name) or name in (".", ".."):
+        raise SpecError(
+            "name", f"a plain file name (letters, digits, '-', '_', '.'; at most 100), got {name!r}"
+        )
+    spec = {"name": name, "description": top.string("description", "")}
+    spec["discretization"] = _discretization(top.table("discretization"))
+    spec["solver"] = _solver(top.table("solver", {}))
+
+    bodies = _bodies(top, base_dir)
+    names = list(bodies)
+    spec["bodies"] = list(bodies.values())
+    spec["pairs"] = pairs = _pairs(top, bodies)
+    boundaries = _boundaries(top, names)
+    spec["boundaries"] = list(boundaries.values())
+    bnames = list(boundaries)
+    loads, dirichlet = _loads(top, spec, names, bnames)
 
     stages = top.tables("stages")
     spec["stages"] = [
