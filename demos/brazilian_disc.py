@@ -19,6 +19,7 @@ Results and discussion: docs/demos/brazilian_disc.md
 
 import importlib.util
 import sys
+from functools import partial
 
 import numpy as np
 
@@ -27,10 +28,11 @@ if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNot
              "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
-from dolfinx_forms.app.mpm_run import Steps, binned_mean
+from dolfinx_forms.app.mpm_run import Steps
 from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
-from meshes.mpm import brazilian_disc
+from meshes.mpm import brazilian_disc, check_brazilian_disc
+from meshes.plots import brazilian_disc_plots as disc_plots
 
 # fmt: off
 OPTIONS = [  # option, kind, default[, help]
@@ -41,10 +43,9 @@ OPTIONS = [  # option, kind, default[, help]
     ("--step-displacement", "(0, inf)", 0.02, "platen travel per step (mm)"),
     ("--steps", range(1, 10001), 50),
     ("--h", "(0, inf)", 0.2, "grid spacing (mm)"),
-    ("--eps0", "(0, inf)", 0.6,
-     "penalty factor (eq 51, eps = eps0 h / (2 E) against the rigid platens); 0.6: the "
-     "penalty's compliance stays well below the disc's at a = 5 h (eps0 = 2 widens a by 13 %% "
-     "there)"),
+    ("--eps0", "(0, inf)", 0.6, "penalty factor (eq 51, eps = eps0 h / (2 E) against the rigid "
+     "platens); 0.6: the penalty's compliance stays well below the disc's at a = 5 h (eps0 = 2 "
+     "widens a by 13 %% there)"),
     ("--series-every", range(1, 10001), 10, "steps between frames of the time series"),
 ]
 COLUMNS = ["step", "displacement", "force_top", "force_bottom", "half_width_top",
@@ -53,33 +54,13 @@ COLUMNS = ["step", "displacement", "force_top", "force_bottom", "half_width_top"
 
 
 def parse(argv):
-    p = cli.demo_parser(
-        "brazilian_disc.py",
-        __doc__,
-        "results/brazilian_disc",
-        OPTIONS,
-        discretization=False,
-        enforcement=cli.MPM_ENFORCEMENT,
-    )
+    p = cli.demo_parser("brazilian_disc.py", __doc__, "results/brazilian_disc", OPTIONS,
+                        discretization=False, enforcement=cli.MPM_ENFORCEMENT)  # fmt: skip
     a = p.parse_args(argv)
-    if not a.h <= a.R / 5:
-        p.error(
-            f"--h: must be in (0, R/5] = (0, {a.R / 5:g}] (at least 10 cells across), got {a.h}"
-        )
-    if not a.R / a.h <= 2000:
-        p.error(
-            f"--h: must be >= R/2000 = {a.R / 2000:g} (grid of at most 4000^2 cells), got {a.h}"
-        )
-    if not a.steps * a.step_displacement <= 0.2 * a.R:
-        p.error(
-            f"--step-displacement: steps x step must be <= 0.2 R = {0.2 * a.R:g} "
-            f"(small-strain MPM), got {a.steps * a.step_displacement:g}"
-        )
-    if not a.step_displacement <= 0.5 * a.h:
-        p.error(
-            f"--step-displacement: must be <= h/2 = {0.5 * a.h:g} per step (contact band "
-            f"and level-set advection), got {a.step_displacement}"
-        )
+    try:  # 10 to 4000 cells across, small strain, at most h/2 per step
+        check_brazilian_disc(a.R, a.h, a.steps, a.step_displacement)
+    except ValueError as e:
+        p.error(str(e))
     return a
 
 
@@ -90,88 +71,43 @@ def hertz_half_width(F, R, E, nu):
 
 def evaluate(run):
     """Hertz half-width where a > 5 h, force balance, area vs point volume, mass."""
-    p, rows = run.params, run.rows
-    F = np.array([r["force_top"] for r in rows])
-    Fb = np.array([r["force_bottom"] for r in rows])
+    p, rows, recs = run.params, run.rows, run.records
+    F, Fb = (np.array([r[k] for r in rows]) for k in ("force_top", "force_bottom"))
     a = np.array([[r["half_width_top"], r["half_width_bottom"]] for r in rows])
     a_h = hertz_half_width(F, p["R"], p["E"], p["nu"])
-    judged = a.min(axis=1) > 5 * p["h"]
-    err = np.abs(a / a_h[:, None] - 1)
+    judged, err = a.min(axis=1) > 5 * p["h"], np.abs(a / a_h[:, None] - 1)
     balance = np.abs(F - Fb) / np.maximum(np.abs(F), 1e-300)
-    area = np.array([r["area_levelset"] for r in rows])
-    vol = np.array([r["volume_points"] for r in rows])
-    mass = [r["mass"]["disc"] for r in run.records]
+    area, vol = (np.array([r[k] for r in rows]) for k in ("area_levelset", "volume_points"))
     run.results.update(
-        force_top=F.tolist(),
-        force_bottom=Fb.tolist(),
-        half_width=a.tolist(),
+        force_top=F.tolist(), force_bottom=Fb.tolist(), half_width=a.tolist(),
         half_width_rel_error_max=float(err[judged].max()) if judged.any() else None,
-        steps_judged=int(judged.sum()),
-        force_balance_rel_max=float(balance.max()),
+        steps_judged=int(judged.sum()), force_balance_rel_max=float(balance.max()),
         area_vs_points_rel_max=float(np.max(np.abs(area / vol - 1))),
-        mass_rel_change=float(abs(mass[-1] / mass[0] - 1)),
+        mass_rel_change=float(abs(recs[-1]["mass"]["disc"] / recs[0]["mass"]["disc"] - 1)),
         newton_iterations_mean=float(np.mean([r["newton_iterations"] for r in rows])),
-        reinitializations=int(sum(r["reinitialized"]["disc"] for r in run.records)),
-        gradient_drift_max=float(max(r["gradient_drift"]["disc"] for r in run.records)),
-        points_outside_cells_max=int(max(r["points_outside_cells"] for r in run.records)),
-    )
+        reinitializations=int(sum(r["reinitialized"]["disc"] for r in recs)),
+        gradient_drift_max=float(max(r["gradient_drift"]["disc"] for r in recs)),
+        points_outside_cells_max=int(max(r["points_outside_cells"] for r in recs)),
+    )  # fmt: skip
     run.analytic.update(half_width=a_h.tolist())
-    warn = run.metrics["solver"]["warnings"]
+    warn, av = run.metrics["solver"]["warnings"], run.results["area_vs_points_rel_max"]
     if judged.any() and err[judged].max() > 0.05:
         warn.append(f"half-width differs from Hertz by {err[judged].max():.1%} (> 5 %) at a > 5 h")
     if balance.max() > 1e-6:
         warn.append(f"platen forces differ by {balance.max():.1e} relative (> 1e-6)")
-    if run.results["area_vs_points_rel_max"] > 0.01:
-        warn.append(
-            f"level-set area and point volume differ by {run.results['area_vs_points_rel_max']:.1%}"
-        )
-    run.results["mls_widened_points"] = int(sum(r["mls_widened"] for r in run.records))
-
-
-def plots(run, folder):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    p, rows = run.params, run.rows
-    F = np.array([r["force_top"] for r in rows])
-    Fs = np.linspace(0, F.max(), 200)
-    fig, ax = plt.subplots(figsize=(5, 4))
-    ax.plot(Fs, hertz_half_width(Fs, p["R"], p["E"], p["nu"]), "k-", label="Hertz")
-    ax.plot(F, [r["half_width_top"] for r in rows], "o", ms=3, label="top platen")
-    ax.plot(F, [r["half_width_bottom"] for r in rows], "x", ms=3, label="bottom platen")
-    ax.axhline(5 * p["h"], color="0.6", ls=":", label="5 h")
-    ax.set(xlabel="F (N/mm)", ylabel="a (mm)", title="Brazilian disc: contact half-width")
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(folder / "half_width.png", dpi=120)
-    plt.close(fig)
-    frames = run.data["series"]["disc"].frames  # (step, x, {stress, ...}, cells)
-    frames = [
-        frames[k] for k in sorted({0, len(frames) // 3, 2 * len(frames) // 3, len(frames) - 1})
-    ]
-    fig, axes = plt.subplots(1, len(frames), figsize=(3.2 * len(frames), 3.4), squeeze=False)
-    lo = min(f[2]["stress"][:, 1].min() for f in frames)
-    for ax, (step, x, data, _) in zip(axes[0], frames):
-        image, extent = binned_mean(x, data["stress"][:, 1], p["h"])
-        sc = ax.imshow(image, extent=extent, origin="lower", cmap="viridis", vmin=lo, vmax=0)
-        ax.set(aspect="equal", title=f"step {step:g}", xticks=[], yticks=[])
-    fig.colorbar(sc, ax=axes[0].tolist(), label="sigma_yy at the material points (N/mm^2)")
-    fig.savefig(folder / "sigma_yy.png", dpi=120)
-    plt.close(fig)
+    if av > 0.01:
+        warn.append(f"level-set area and point volume differ by {av:.1%}")
+    run.results["mls_widened_points"] = int(sum(r["mls_widened"] for r in recs))
 
 
 def summary(run):
-    r = run.results
-    err = r["half_width_rel_error_max"]
+    r, err = run.results, run.results["half_width_rel_error_max"]
+    err = "n/a" if err is None else f"{err:.2%}"
     return (
         f"Brazilian disc: {len(run.rows)} steps, F = {r['force_top'][-1]:.6g} N/mm, "
         f"a = {r['half_width'][-1][0]:.4g} mm (Hertz {run.analytic['half_width'][-1]:.4g}), "
-        f"max |a/a_Hertz - 1| over {r['steps_judged']} steps with a > 5 h: "
-        + ("n/a" if err is None else f"{err:.2%}")
-        + f", force balance {r['force_balance_rel_max']:.1e}, "
-        f"Newton {r['newton_iterations_mean']:.1f} per step"
+        f"max |a/a_Hertz - 1| over {r['steps_judged']} steps with a > 5 h: {err}, force balance "
+        f"{r['force_balance_rel_max']:.1e}, Newton {r['newton_iterations_mean']:.1f} per step"
     )
 
 
@@ -179,49 +115,34 @@ def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
     with Run("brazilian", vars(args), discretization="cut", plot=False) as run:
         # the scene: the disc's level set and material points, the two rigid platens, moving
-        grid, (name, tag, shape), platens, scene = brazilian_disc(
-            run.comm, args.R, args.h, args.step_displacement, args.steps
-        )
-        # the problem: the disc (plane strain, linear elastic) between the platens, x = 0 held
-        # horizontally (the symmetry line)
+        scene_args = (args.R, args.h, args.step_displacement, args.steps)
+        grid, (name, tag, shape), platens, scene = brazilian_disc(run.comm, *scene_args)
+        # the problem: the disc (plane strain, linear elastic) between the platens, u_x = 0 on x = 0
         symmetry = Dirichlet(lambda x: np.isclose(x[0], 0.0, atol=1e-9 * args.R), 0, 0.0)
-        sim = ImplicitMPM(
-            run.comm,
-            grid,
-            [MPMBody(name, tag, (args.E, args.nu), shape)],
-            scene,
-            obstacles=platens,
-            dirichlet=[symmetry],
-            timer=run.timer,
-            **run.problem_options,  # mu, eps0, --petsc, --linear-solver
-        )
+        body = MPMBody(name, tag, (args.E, args.nu), shape)
+        kw = dict(obstacles=platens, dirichlet=[symmetry], timer=run.timer)
+        sim = ImplicitMPM(run.comm, grid, [body], scene, **kw, **run.problem_options)
 
         # the run: the platens close by step_displacement per step
         steps = Steps(run, sim, COLUMNS, args.steps, args.series_every)
         for _ in range(args.steps):
             rec = steps.step()
             widths = {q["body_j"]: q["half_width"] for q in rec["pairs"]}
-            steps.rows.append(
-                dict(
-                    step=rec["step"],
-                    displacement=rec["step"] * args.step_displacement,
-                    force_top=rec["obstacles"]["platen_top"]["fy"],
-                    force_bottom=-rec["obstacles"]["platen_bottom"]["fy"],
-                    half_width_top=widths.get("platen_top", 0.0),
-                    half_width_bottom=widths.get("platen_bottom", 0.0),
-                    area_levelset=rec["area_levelset"]["disc"],
-                    volume_points=rec["volume_points"]["disc"],
-                    newton_iterations=rec["newton_iterations"],
-                    wall_s=rec["wall_s"],
-                )
-            )
+            obst, k = rec["obstacles"], rec["step"]
+            steps.rows.append(dict(
+                step=k, displacement=k * args.step_displacement,
+                force_top=obst["platen_top"]["fy"], force_bottom=-obst["platen_bottom"]["fy"],
+                **{f"half_width_{s}": widths.get(f"platen_{s}", 0.0) for s in ("top", "bottom")},
+                area_levelset=rec["area_levelset"]["disc"],
+                volume_points=rec["volume_points"]["disc"],
+                newton_iterations=rec["newton_iterations"], wall_s=rec["wall_s"],
+            ))  # fmt: skip
         steps.measure()
 
-        # the check: Hertz's half-width where a > 5 h, force balance, area against the
-        # points' volume, mass (rank 0)
+        # the check (rank 0): Hertz's half-width where a > 5 h, force balance, area, mass
         if run.rank0:
             evaluate(run)
-        run.finish(summary, **steps.outputs(plots))
+        run.finish(summary, **steps.outputs(partial(disc_plots, half_width=hertz_half_width)))
     return run.status
 
 

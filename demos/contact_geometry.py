@@ -29,6 +29,7 @@ from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
 from dolfinx_forms.io.output import write_columns
 from dolfinx_forms.solvers.newton import ContactSolverError
+from meshes.plots import contact_geometry_plot
 
 OPTIONS = [  # option, kind, default[, help]
     ("--R", "(0, inf)", 10.0, "radius (mm)"),
@@ -86,35 +87,14 @@ def evaluate(run):
 
 def files(run, folder):
     """contact_points.csv and contact_geometry.png (the bodies and Gamma_c; g_n0 vs exact)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    d, sc = run.data, run.scene
-    s, x = d["s"], d["s"]["points"]
-    pi, pj, n = d["pi"]["points"], d["pj"]["points"], s["normals"]
+    d, x, n = run.data, run.data["s"]["points"], run.data["s"]["normals"]
+    pi, pj = d["pi"]["points"], d["pj"]["points"]
     write_columns(
         folder / "contact_points.csv", x=x[:, 0], y=x[:, 1], nx=n[:, 0], ny=n[:, 1],
-        weight=s["weights"], pi_x=pi[:, 0], pi_y=pi[:, 1], pj_x=pj[:, 0], pj_y=pj[:, 1],
+        weight=d["s"]["weights"], pi_x=pi[:, 0], pi_y=pi[:, 1], pj_x=pj[:, 0], pj_y=pj[:, 1],
         g_n0=d["g_n0"],
     )  # fmt: skip
-    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
-    X = sc.grid.nodes().reshape(sc.grid.shape + (2,))
-    ax[0].contour(X[..., 0], X[..., 1], sc.block.values, [0], colors="k")
-    ax[0].contour(X[..., 0], X[..., 1], sc.cyl.values, [0], colors="b")
-    for seg in s["segments"]:
-        ax[0].plot(seg[:, 0], seg[:, 1], "g-")
-    ax[0].set_aspect("equal")
-    ax[0].set_title("bodies (black, blue) and $\\Gamma_c$ (green)")
-    ax[1].plot(x[:, 0], d["g_n0"], "g.", label="computed $g_{n0}$")
-    order = np.argsort(x[:, 0])
-    ax[1].plot(x[order, 0], d["exact"][order], "k-", lw=0.8, label="exact")
-    ax[1].set(xlabel="x (mm)", ylabel="initial normal gap $g_{n0}$ (mm), eq 28")
-    ax[1].legend()
-    fig.tight_layout()
-    fig.savefig(folder / "contact_geometry.png", dpi=120)
-    plt.close(fig)
+    contact_geometry_plot(run, folder / "contact_geometry.png")
 
 
 SUMMARY = (

@@ -36,18 +36,11 @@ if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNot
     sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
              "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
 from dolfinx_forms.app import cli, study
-from dolfinx_forms.app.study import (
-    CASE,
-    CIRCLE_ERROR,
-    ERROR_LABELS,
-    ERRORS,
-    VARIANTS,
-    hertz_reference,
-)
+from dolfinx_forms.app.study import CASE, CIRCLE_ERROR, ERROR_LABELS, ERRORS, VARIANTS
+from dolfinx_forms.app.study import hertz_reference
 from dolfinx_forms.io.folders import OutputFolderError
 
 HERTZ = Path(__file__).resolve().with_name("hertz.py")  # the demo every run of the study runs
-
 
 
 def run_hertz(h, variant_args=(), timeout=None, keep=None):
@@ -64,8 +57,7 @@ OPTIONS = [
 ]
 MIN_RATE = 0.75  # the check: fitted rate of the p(x) L2 error in h (theory: 1)
 CHECK = ("pressure_rel_l2_error", "p(x) L2 error", MIN_RATE)  # error, its name, least rate
-# also against the circle the scene meshes (Hertz's parabola is 0.4 % off it at a/R = 0.1):
-# rates reported, not checked
+# also against the circle the scene meshes (the parabola is 0.4 % off at a/R = 0.1): not checked
 STUDY_ERRORS = (*ERRORS, CIRCLE_ERROR)
 LABELS = {**ERROR_LABELS, CIRCLE_ERROR: "p(x) L2 vs circle"}
 DEFINITIONS = dict(
@@ -87,12 +79,9 @@ DEFINITIONS = dict(
 def parse(argv):
     p = cli.DemoParser(prog="convergence_study.py", description=__doc__.split("\n\n")[0])
     cli.add_options(p, OPTIONS[:1])
-    p.add_argument(
-        "--sizes",
-        default=",".join(map(str, SIZES)),
-        help="comma-separated k of the mesh sizes h = a/k, at least 2 distinct, "
-        "each in [2, 400] (default 10,20,40,80)",
-    )
+    ks = ",".join(map(str, SIZES))
+    what = "comma-separated k of the mesh sizes h = a/k, at least 2 distinct, each in [2, 400]"
+    p.add_argument("--sizes", default=ks, help=f"{what} (default {ks})")
     p.add_out("results/convergence")
     cli.add_options(p, OPTIONS[1:])
     a = p.parse_args(argv)
@@ -134,24 +123,16 @@ def main(argv=None):
         groups = {d: [r for r in runs if r["discretization"] == d] for d in ds}
         summary = {d: study.convergence(groups[d], STUDY_ERRORS, *CHECK) for d in ds}
         data = dict(
-            study="hertz convergence in h (frictionless, demos/hertz.py)",
-            case=CASE,
-            a_hertz=a,
-            p0_hertz=p0,
-            sizes=args.sizes,
-            h=[a / k for k in args.sizes],
-            discretizations=ds,
-            variants={d: DISCRETIZATIONS[d] for d in ds},
-            hertz_args={d: VARIANTS[DISCRETIZATIONS[d]] for d in ds},
-            **DEFINITIONS,
+            study="hertz convergence in h (frictionless, demos/hertz.py)", case=CASE,
+            a_hertz=a, p0_hertz=p0, sizes=args.sizes, h=[a / k for k in args.sizes],
+            discretizations=ds, variants={d: DISCRETIZATIONS[d] for d in ds},
+            hertz_args={d: VARIANTS[DISCRETIZATIONS[d]] for d in ds}, **DEFINITIONS,
             runs=[dict(r, files=f"runs/{r['name']}" if r["ok"] else None) for r in runs],
             summary=summary,
-        )
+        )  # fmt: skip
         panels = [(f"{d} ({DISCRETIZATIONS[d]})", groups[d], summary[d]) for d in ds]
-        title = (
-            f"Hertz line contact: convergence in h (a = {a:.4g} mm, h = a/k, "
-            f"k = {', '.join(map(str, args.sizes))})"
-        )
+        ks = ", ".join(map(str, args.sizes))
+        title = f"Hertz line contact: convergence in h (a = {a:.4g} mm, h = a/k, k = {ks})"
         plot = lambda path: study.plot_errors(  # noqa: E731
             path, panels, LABELS, title, reference="pressure_rel_l2_error"
         )

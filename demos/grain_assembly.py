@@ -28,9 +28,10 @@ if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNot
              "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
-from dolfinx_forms.app.mpm_run import Steps, plot_force_chains
+from dolfinx_forms.app.mpm_run import Steps
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody, equilibrium_error
-from meshes.assembly import grain_assembly
+from meshes.assembly import grain_assembly, plate_frame_forces
+from meshes.plots import grain_assembly_plots
 
 # fmt: off
 OPTIONS = [  # option, kind, default[, help]
@@ -53,14 +54,8 @@ COLUMNS = ["step", "phase"] + [f"{p}_{c}" for p in PLATES for c in ("normal", "t
 
 
 def parse(argv):
-    p = cli.demo_parser(
-        "grain_assembly.py",
-        __doc__,
-        "results/grain_assembly",
-        OPTIONS,
-        discretization=False,
-        enforcement=cli.MPM_ENFORCEMENT,
-    )
+    p = cli.demo_parser("grain_assembly.py", __doc__, "results/grain_assembly", OPTIONS,
+                        discretization=False, enforcement=cli.MPM_ENFORCEMENT)  # fmt: skip
     a = p.parse_args(argv)
     if not 5 <= a.radius / a.h <= 100:
         p.error(f"--h: must give 5 <= radius/h <= 100 (radius {a.radius:g}), got {a.h}")
@@ -71,29 +66,6 @@ def parse(argv):
     if a.steps + a.shear_steps == 0:
         p.error("--steps: at least one compression or shear step is needed")
     return a
-
-
-def plate_row(rec, plates, phase):
-    """The steps.csv row: plate forces in each plate's frame (normal: compression positive)."""
-    out = dict(
-        step=rec["step"],
-        phase=phase,
-        newton_iterations=rec["newton_iterations"],
-        wall_s=rec["wall_s"],
-    )
-    inward = {
-        "plate_left": (1, 0),
-        "plate_right": (-1, 0),
-        "plate_bottom": (0, 1),
-        "plate_top": (0, -1),
-    }
-    for name in PLATES:
-        a = plates[name].angle
-        m = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]]) @ inward[name]
-        f = np.array([rec["obstacles"][name]["fx"], rec["obstacles"][name]["fy"]])
-        out[f"{name}_normal"] = float(-f @ m)
-        out[f"{name}_tangential"] = float(f @ np.array([-m[1], m[0]]))
-    return out
 
 
 def evaluate(run):
@@ -111,28 +83,6 @@ def evaluate(run):
     )
     if worst > 1e-8:
         warn.append(f"equilibrium of the grains or plates off by {worst:.1e} (> 1e-8)")
-
-
-def plots(run, folder):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    plot_force_chains(run.sim, run.records[-1], folder / "force_chains.png", "grain assembly")
-    fig, ax = plt.subplots(figsize=(6, 4))
-    steps = [r["step"] for r in run.rows]
-    for name in ("plate_top", "plate_left"):
-        ax.plot(steps, [r[f"{name}_normal"] for r in run.rows], "-", label=f"{name} normal")
-        ax.plot(
-            steps, [r[f"{name}_tangential"] for r in run.rows], "--", label=f"{name} tangential"
-        )
-    ax.axvline(run.params["steps"] + 0.5, color="0.6", ls=":")
-    ax.set(xlabel="step", ylabel="force (N/mm)", title="plate forces (compression | shear)")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(folder / "plate_forces.png", dpi=120)
-    plt.close(fig)
 
 
 def summary(run):
@@ -157,16 +107,11 @@ def main(argv=None):
             plates[name].translation = np.array(t, float)
         run.data.update(plates=plates, height=box[1, 1] - box[0, 1])
         # the problem: Coulomb friction at the friction angle, on grains and plates alike
-        sim = ImplicitMPM(
-            run.comm,
-            grid,
-            [MPMBody(n, t, (args.E, args.nu), s) for n, t, s in bodies],
-            scene,
-            obstacles=list(plates.values()),
-            mu=np.tan(np.radians(args.friction_angle)),
-            predictor_gap=0.5 * args.h,
-            timer=run.timer,
-            **run.problem_options,  # eps0, --petsc, --linear-solver
+        mpm_bodies = [MPMBody(n, t, (args.E, args.nu), s) for n, t, s in bodies]
+        mu = np.tan(np.radians(args.friction_angle))
+        kw = dict(obstacles=list(plates.values()), mu=mu, predictor_gap=0.5 * args.h)
+        sim = ImplicitMPM(  # problem_options: eps0, --petsc, --linear-solver
+            run.comm, grid, mpm_bodies, scene, **kw, timer=run.timer, **run.problem_options
         )
 
         # the run: compression by the four plates, then simple shear (the lateral plates turn)
@@ -174,7 +119,10 @@ def main(argv=None):
         for _ in range(args.steps + args.shear_steps):
             rec = steps.step()
             phase = "compression" if rec["step"] <= args.steps else "shear"
-            steps.rows.append(plate_row(rec, plates, phase))
+            steps.rows.append(dict(
+                step=rec["step"], phase=phase, newton_iterations=rec["newton_iterations"],
+                wall_s=rec["wall_s"], **plate_frame_forces(rec, plates),
+            ))  # fmt: skip
             if rec["step"] == args.steps:  # compression done: turn the lateral plates from now on
                 run.data["end_of_compression"] = rec
                 for name in PLATES:
@@ -186,7 +134,7 @@ def main(argv=None):
         # the check (rank 0)
         if run.rank0:
             evaluate(run)
-        run.finish(summary, **steps.outputs(plots))
+        run.finish(summary, **steps.outputs(grain_assembly_plots))
     return run.status
 
 

@@ -34,21 +34,17 @@ if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNot
 from dolfinx_forms.analysis import analytic, compare, post
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
-from dolfinx_forms.fem.boundary import Dirichlet, nearest_vertex_marker
-from dolfinx_forms.io.output import plot_lines
+from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.solvers.protocol import friction_on, ramp
-from meshes.cut import cut_counts, incline_cut_scene
-from meshes.incline import incline_scene
+from meshes.cut import fitted_or_cut, incline_cut_scene
+from meshes.incline import SUPPORTS, SUPPORTS_HELP, bottom_vertex, incline_scene
+from meshes.plots import slip_plot
 
 SIZE, SLOPE, INTERCEPT = 1000.0, 0.2, 458.6  # mm; interface y = SLOPE x + INTERCEPT
 X0 = SIZE / 2  # u_x = 0 at x = X0 on top and bottom (uniaxial supports)
 LINE = dict(size=SIZE, slope=SLOPE, intercept=INTERCEPT)
 SLIP_TOL = 1e-6  # plastic slip threshold, relative to the imposed displacement
 THRESHOLD = f"max |g_t^p| > {SLIP_TOL:g} d at points farther than h from the sides x = 0, x = size"
-SUPPORTS_HELP = (
-    "uniaxial: u_x of the uniform uniaxial state on top and bottom; held: top u_x = 0, bottom on "
-    "rollers with its middle point fixed"
-)
 OPTIONS = [  # option, kind, default[, help]
     ("--h", "(0, 250]", 25.0, "mesh size (mm; cut: grid spacing 1000 / round(1000 / h))"),
     ("--mu", "[0, inf)", 0.19, "Coulomb friction coefficient (tan theta = 0.2)"),
@@ -62,23 +58,13 @@ OPTIONS = [  # option, kind, default[, help]
     ("--gauss", range(1, 6), 2, "Gauss points per contact-surface segment"),
     ("--degree", [1, 2], 1),
 ]
-CELLS = (
-    False,
-    "quadrilateral cells (the cut grid is always quadrilateral)",
-    "triangular cells (default; conforming only, ignored with cut)",
-)
-SUPPORTS = {
-    "uniaxial": "top: u_y = -d, u_x = e_xx (x - 500); bottom: u_y = 0, u_x = e_xx (x - 500); "
-    "sides free (e_xx: lateral strain of the uniform uniaxial state, penalty compliance included)",
-    "held": "top: u_y = -d, u_x = 0; bottom: u_y = 0 (rollers), u_x = 0 at the bottom vertex "
-    "nearest to (500, 0); sides free",
-}
+CELLS = (False, "quadrilateral cells (the cut grid is always quadrilateral)",
+         "triangular cells (default; conforming only, ignored with cut)")  # fmt: skip
 
 
 def parse(argv):
-    p = cli.demo_parser(
-        "inclined_interface.py", __doc__, "results/inclined_interface", OPTIONS, cells=CELLS
-    )
+    p = cli.demo_parser("inclined_interface.py", __doc__, "results/inclined_interface",
+                        OPTIONS, cells=CELLS)  # fmt: skip
     a = p.parse_args(argv)
     cli.check_scale(p, a, SIZE, "square")
     return a
@@ -91,9 +77,8 @@ def evaluate(run):
     interior = (pts["state"] != 0) & (x > h) & (x < SIZE - h)
     res.update(reaction=run.reactions["upper_top"], contact_half_width=None)  # all in contact
     res.update(peak_pressure=compare.extreme(pn), max_tangential_jump=compare.extreme(np.abs(gt)))
-    res["max_tangential_jump_interior"] = compare.extreme(
-        np.abs(gt[(gt_x > h) & (gt_x < SIZE - h)])
-    )
+    away = (gt_x > h) & (gt_x < SIZE - h)  # from the sides
+    res["max_tangential_jump_interior"] = compare.extreme(np.abs(gt[away]))
     res.update(compare.slip_results(pts, interior, SLIP_TOL * p["displacement"]))
     res["max_newton_iterations"] = max(run.metrics["solver"]["newton_iterations"], default=None)
     run.analytic.update(traction_ratio=SLOPE, slips=bool(p["mu"] < SLOPE))
@@ -106,21 +91,10 @@ def evaluate(run):
             res["pressure_rel_l2_error"] = compare.rel_l2(wi, pi, np.full_like(pi, an["pressure"]))
             res["traction_rel_l2_error"] = compare.rel_l2(wi, qi, np.full_like(qi, an["shear"]))
         ends = np.array([0.0, SIZE])
-        run.curves["uniform state p_n"] = (ends, [ref["p_n"]] * 2)
-        run.curves["uniform state tau_t"] = (ends, [ref["tau_t"]] * 2)
+        run.curves.update({f"uniform state {k}": (ends, [ref[k]] * 2) for k in ("p_n", "tau_t")})
     verdict = "slips" if res["slips"] else "sticks"
     run.data["verdict"] = f"mu = {p['mu']:g}, tan theta = {SLOPE:g}: {verdict}"
     run.plot_kw = dict(title=f"inclined interface, {run.data['verdict']}")
-
-
-def files(run, folder):
-    """slip.png: plastic slip g_t^p and total tangential jump g_t along the interface."""
-    (gt_x, gt), h, pts = run.data["g_t"], run.params["h"], run.pts
-    o = np.argsort(gt_x)
-    lines = {"total jump g_t": (gt_x[o], gt[o], "-")}
-    lines["plastic slip g_t^p"] = (pts["x"], pts["slip"], ".")
-    title, margins = f"{run.data['verdict']}; dotted: end margin h", (h, SIZE - h)
-    plot_lines(folder / "slip.png", lines, title, ylabel="tangential jump (mm)", vlines=margins)
 
 
 def summary(run):
@@ -140,20 +114,13 @@ def main(argv=None):
     params.update(boundary_conditions=SUPPORTS[args.supports], slip_threshold=THRESHOLD)
     with Run("incline", params) as run:
         # the scene: gmsh bodies below and above the interface, or one uniform grid it cuts
-        with run.phase("mesh"):
-            if args.discretization == "conforming":
-                run.scene = incline_scene(run.comm, h=args.h, quads=args.quads, **LINE)
-            else:
-                run.scene = incline_cut_scene(run.comm, h=args.h, **LINE)
-                run.metrics["mesh"]["cut_cells"] = cut_counts(run.scene)
+        run.scene = fitted_or_cut(run, incline_scene, incline_cut_scene, args.h, args.quads, **LINE)
 
         # the problem: top and bottom held (SUPPORTS); the uniform state of the penalised one
         top_y, top_x = Dirichlet("upper_top", 1, 0.0), Dirichlet("upper_top", 0)
-        if args.supports == "uniaxial":
-            bottom_x = Dirichlet("lower_bottom", 0, 0.0)
-        else:  # rollers, with the bottom vertex nearest to x = X0 held
-            bottom = lambda x: np.isclose(x[1], 0.0)  # noqa: E731
-            bottom_x = Dirichlet(nearest_vertex_marker(run.scene.mesh, (X0, 0.0), bottom), 0)
+        bottom_x = Dirichlet("lower_bottom", 0, 0.0)
+        if args.supports == "held":  # rollers, with the bottom vertex nearest to x = X0 held
+            bottom_x = Dirichlet(bottom_vertex(run.scene.mesh, X0), 0)
         bcs = [top_y, Dirichlet("lower_bottom", 1, 0.0), top_x, bottom_x]
         pb = run.problem = run.contact_problem(bcs, mu=0.0, band=args.h)
         state = (args.E, args.nu, args.displacement, SIZE, SLOPE, pb.eps_n, pb.eps_t)
@@ -167,18 +134,15 @@ def main(argv=None):
         loads, targets = [top_y], [-args.displacement]
         if args.supports == "uniaxial":
             loads, targets = loads + [top_x, bottom_x], targets + [u_x(ref["gx"]), u_x(0.0)]
-        run.records = [
-            friction_on(pb, args.mu),
-            ramp(pb, loads, targets, args.steps, label="incline"),
-        ]
+        run.records = [friction_on(pb, args.mu)]
+        run.records.append(ramp(pb, loads, targets, args.steps, label="incline"))
         run.measure(reactions=["upper_top"])
-        # the total tangential jump g_t (elastic + plastic), gathered on rank 0
-        run.data["g_t"] = post.tangential_jumps(pb)
+        run.data["g_t"] = post.tangential_jumps(pb)  # g_t (elastic + plastic), on rank 0
 
         # the check (rank 0)
         if run.rank0:
             evaluate(run)
-        run.finish(summary, files=files)
+        run.finish(summary, files=slip_plot)  # slip.png
     return run.status
 
 

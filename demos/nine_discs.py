@@ -30,7 +30,7 @@ from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
 from dolfinx_forms.app.mpm_run import Steps, plot_force_chains
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody, equilibrium_error
-from meshes.mpm import nine_discs, plate_face_conditions, plate_forces
+from meshes.mpm import d4_symmetry_error, nine_discs, plate_face_conditions, plate_forces
 
 # fmt: off
 OPTIONS = [  # option, kind, default[, help]
@@ -47,30 +47,11 @@ OPTIONS = [  # option, kind, default[, help]
 COLUMNS = ["step", "displacement", "force_left", "force_right", "force_bottom", "force_top",
            "newton_iterations", "wall_s"]
 # fmt: on
-D4 = [
-    np.array(m, float)
-    for m in (
-        [[1, 0], [0, 1]],
-        [[0, -1], [1, 0]],
-        [[-1, 0], [0, -1]],
-        [[0, 1], [-1, 0]],
-        [[-1, 0], [0, 1]],
-        [[1, 0], [0, -1]],
-        [[0, 1], [1, 0]],
-        [[0, -1], [-1, 0]],
-    )
-]
 
 
 def parse(argv):
-    p = cli.demo_parser(
-        "nine_discs.py",
-        __doc__,
-        "results/nine_discs",
-        OPTIONS,
-        discretization=False,
-        enforcement=cli.MPM_ENFORCEMENT,
-    )
+    p = cli.demo_parser("nine_discs.py", __doc__, "results/nine_discs", OPTIONS,
+                        discretization=False, enforcement=cli.MPM_ENFORCEMENT)  # fmt: skip
     a = p.parse_args(argv)
     k = (3 * a.R + 1.0) / a.h
     if abs(k - round(k)) > 1e-9 * k or not 10 <= a.R / a.h <= 200:
@@ -82,53 +63,19 @@ def parse(argv):
     return a
 
 
-def symmetry_error(sim, rec, h):
-    """Largest relative differences under D4: contact forces (by the contact's centre) and the
-    stress at the material points (by position: their images within 1e-4 h; from step 2 on
-    the points move with a field that is D4-symmetric only to the MLS projection's error)."""
-    from scipy.spatial import cKDTree
-
-    act = [q for q in rec["pairs"] if q["normal_force"] > 0]
-    c = np.array([[q["x"], q["y"]] for q in act])
-    fn = np.array([q["normal_force"] for q in act])
-    ft = np.abs([q["tangential_force"] for q in act])
-    x = np.concatenate([p.x for p in sim.points.values()])
-    s = np.concatenate([p.stress for p in sim.points.values()])
-    S = np.stack([np.stack([s[:, 0], s[:, 2]], 1), np.stack([s[:, 2], s[:, 1]], 1)], 1)
-    tc, tx = cKDTree(c), cKDTree(x)
-    e_f = e_s = e_x = 0.0
-    n_same = len(x)
-    for G in D4:
-        d, k = tc.query(c @ G.T)
-        e_x = max(e_x, d.max())
-        e_f = max(e_f, np.max(np.abs(fn[k] - fn)), np.max(np.abs(ft[k] - ft)))
-        # stresses at the points whose image is a point: those of the interior cells' tensor
-        # Gauss rule (the cut cells' sub-triangle rule is not D4-invariant)
-        d, k = tx.query(x @ G.T)
-        same = d < 1e-4 * h
-        Sg = np.einsum("ab,nbc,dc->nad", G, S, G)
-        e_s = max(e_s, np.max(np.abs(S[k[same]] - Sg[same]), initial=0.0))
-        n_same = min(n_same, int(same.sum())) if G is not D4[0] else int(same.sum())
-    return e_f / fn.max(), e_s / np.abs(S).max(), e_x, n_same / len(x)
-
-
 def evaluate(run):
     sim, rec = run.sim, run.records[-1]
-    e_f, e_s, e_x, frac = symmetry_error(sim, rec, run.params["h"])
+    e_f, e_s, e_x, frac = d4_symmetry_error(sim, rec, run.params["h"])
     forces = np.array([v[:2] for v in rec["body_forces"].values()])
     fmax = max(q["normal_force"] for q in rec["pairs"])
     eq = equilibrium_error(rec)  # contacts + supports (the plates' outer faces)
     run.results.update(
-        symmetry_force_rel=e_f,
-        symmetry_stress_rel=e_s,
-        symmetry_position_max=e_x,
-        symmetry_points_compared=frac,
-        equilibrium_rel=eq,
+        symmetry_force_rel=e_f, symmetry_stress_rel=e_s, symmetry_position_max=e_x,
+        symmetry_points_compared=frac, equilibrium_rel=eq,
         newton_iterations=[r["newton_iterations"] for r in run.records],
         contacts=len([q for q in rec["pairs"] if q["normal_force"] > 0]),
-        max_normal_force=fmax,
-        plate_forces=forces[-4:].tolist(),
-    )
+        max_normal_force=fmax, plate_forces=forces[-4:].tolist(),
+    )  # fmt: skip
     warn = run.metrics["solver"]["warnings"]
     if max(e_f, e_s) > 1e-6:
         why = (
@@ -163,29 +110,18 @@ def main(argv=None):
         grid, bodies, scene, faces = nine_discs(run.comm, R=args.R, h=args.h, overlap=args.overlap)
         run.data["faces"] = faces
         # the problem: the plates' outer faces moved inward by `displacement` per step
-        sim = ImplicitMPM(
-            run.comm,
-            grid,
-            [MPMBody(n, t, (args.E, args.nu), s) for n, t, s in bodies],
-            scene,
-            dirichlet=plate_face_conditions(faces, args.displacement),
-            timer=run.timer,
-            **run.problem_options,  # mu, eps0, --petsc, --linear-solver
-        )
+        mpm_bodies = [MPMBody(n, t, (args.E, args.nu), s) for n, t, s in bodies]
+        kw = dict(dirichlet=plate_face_conditions(faces, args.displacement), timer=run.timer)
+        sim = ImplicitMPM(run.comm, grid, mpm_bodies, scene, **kw, **run.problem_options)
 
         # the run
         steps = Steps(run, sim, COLUMNS, args.steps, series_every=1)
         for _ in range(args.steps):
             rec = steps.step()
-            steps.rows.append(
-                dict(
-                    step=rec["step"],
-                    displacement=rec["step"] * args.displacement,
-                    **plate_forces(rec),
-                    newton_iterations=rec["newton_iterations"],
-                    wall_s=rec["wall_s"],
-                )
-            )
+            steps.rows.append(dict(
+                step=rec["step"], displacement=rec["step"] * args.displacement, **plate_forces(rec),
+                newton_iterations=rec["newton_iterations"], wall_s=rec["wall_s"],
+            ))  # fmt: skip
         steps.measure()
 
         # the check: D4 symmetry of forces and stresses, every body in equilibrium (rank 0)

@@ -39,7 +39,7 @@ from dolfinx_forms.app.demo import Run
 from dolfinx_forms.fem.boundary import Dirichlet, Traction
 from dolfinx_forms.io.output import write_columns
 from dolfinx_forms.solvers.protocol import friction_on, ramp
-from meshes.cut import cut_counts, two_blocks_cut_scene
+from meshes.cut import fitted_or_cut, two_blocks_cut_scene
 from meshes.two_blocks import two_blocks_scene
 
 SIZES = dict(width_lower=40.0, height=10.0, width_upper=20.0)  # mm (Tur et al. 2009)
@@ -55,11 +55,8 @@ OPTIONS = [  # option, kind, default[, help]
     ("--steps", range(1, 101), 1, "load steps (displacement and side loads together)"),
     ("--degree", [1, 2], 1),
 ]
-CELLS = (
-    True,
-    "quadrilateral cells (default; the cut grid is always quadrilateral)",
-    "triangular cells (conforming only; ignored with cut)",
-)
+CELLS = (True, "quadrilateral cells (default; the cut grid is always quadrilateral)",
+         "triangular cells (conforming only; ignored with cut)")  # fmt: skip
 SIDE_TRACTION = (
     f"p_x = {PX} y (10 - y) MPa inward, p_y = {PY} y (10 - y) MPa upward on lower_left and "
     "lower_right"
@@ -82,11 +79,8 @@ def evaluate(run):
     """Zones, slip signs, pressures, the traction ratio and the sigma_x line (rank 0)."""
     pts, res, prm = run.pts, run.results, run.params
     active, iters = pts["state"] != 0, run.metrics["solver"]["newton_iterations"]
-    res.update(
-        reaction=run.reactions["upper_top"],
-        **post.contact_zones(pts),
-        max_newton_iterations=max(iters, default=None),
-    )
+    res.update(reaction=run.reactions["upper_top"], **post.contact_zones(pts),
+               max_newton_iterations=max(iters, default=None))  # fmt: skip
     if active.any():  # the friction coefficient below which slip starts; penalty compliance
         p, w = pts["p_n"], pts["w"]
         res["max_traction_ratio"] = float(np.max(np.abs(pts["p_t"][active]) / p[active]))
@@ -114,8 +108,7 @@ def summary(run):
         f"two blocks: reaction on the top {r['reaction'][0]:.5g}, {r['reaction'][1]:.5g} "
         f"N/mm; stick zone {zone(r['stick_zone'])}, slip zones {zone(r['slip_zone_left'])} "
         f"(slip sign {r['slip_sign_left']}) and {zone(r['slip_zone_right'])} (slip sign "
-        f"{r['slip_sign_right']}); max {r['max_newton_iterations']} Newton iterations per "
-        "step"
+        f"{r['slip_sign_right']}); max {r['max_newton_iterations']} Newton iterations per step"
     )
 
 
@@ -125,12 +118,8 @@ def main(argv=None):
     params.update(side_traction=SIDE_TRACTION, supports=SUPPORTS)
     with Run("blocks", params) as run:
         # the scene: gmsh blocks, or both blocks on one uniform grid whose cells y = 10 cuts
-        with run.phase("mesh"):
-            if args.discretization == "conforming":
-                run.scene = two_blocks_scene(run.comm, h=args.h, quads=args.quads, **SIZES)
-            else:
-                run.scene = two_blocks_cut_scene(run.comm, h=args.h, **SIZES)
-                run.metrics["mesh"]["cut_cells"] = cut_counts(run.scene)
+        scenes = two_blocks_scene, two_blocks_cut_scene
+        run.scene = fitted_or_cut(run, *scenes, args.h, args.quads, **SIZES)
 
         # the problem: lower bottom clamped, upper top held; side tractions p (x, y) (10 - y)
         y = ufl.SpatialCoordinate(run.scene.mesh)[1]
@@ -138,18 +127,14 @@ def main(argv=None):
         top_y = Dirichlet("upper_top", 1, 0.0)
         left = Traction("lower_left", ufl.as_vector((PX * side, PY * side)))
         right = Traction("lower_right", ufl.as_vector((-PX * side, PY * side)))
-        fixed = [Dirichlet("lower_bottom", None, 0.0), Dirichlet("upper_top", 0, 0.0)]
-        run.problem = run.contact_problem(
-            [*fixed, top_y], mu=0.0, band=args.h, tractions=[left, right]
-        )
+        bcs = [Dirichlet("lower_bottom", None, 0.0), Dirichlet("upper_top", 0, 0.0), top_y]
+        run.problem = run.contact_problem(bcs, mu=0.0, band=args.h, tractions=[left, right])
 
         # the run: friction from the start (zero plastic slip at u = 0), then the displacement
         # and the side loads ramped together
         loads, targets = [top_y, left, right], [-args.displacement, 1.0, 1.0]
-        run.records = [
-            friction_on(run.problem, args.mu),
-            ramp(run.problem, loads, targets, args.steps, label="blocks"),
-        ]
+        run.records = [friction_on(run.problem, args.mu)]
+        run.records.append(ramp(run.problem, loads, targets, args.steps, label="blocks"))
         run.measure(reactions=["upper_top"])
         run.data["sigma_x"] = post.stress_at_points(run.problem, LINE)  # collective
 

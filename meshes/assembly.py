@@ -64,3 +64,22 @@ def grain_assembly(comm, n=15, radius=5.0, h=0.5, aspect=1.25, overlap=None, mar
     bodies = [(f"grain{k}", k + 1, df.Ellipse(tuple(x), a, b, 0.0)) for k, x in enumerate(centres)]
     build = grid_scene(comm, ax[0], ax[1], [(q[0], q[1]) for q in bodies], contact_box=False)
     return (ax[0], ax[1]), bodies, plates, build, np.array([lo, hi]), centres
+
+
+#: the plates of grain_assembly and their inward normals before any rotation
+INWARD = {
+    "plate_left": (1, 0), "plate_right": (-1, 0), "plate_bottom": (0, 1), "plate_top": (0, -1)
+}
+
+
+def plate_frame_forces(record, plates):
+    """The plates' forces of an ImplicitMPM step record in each plate's current frame (rotated
+    by its angle): {name_normal (compression positive), name_tangential}."""
+    out = {}
+    for name, inward in INWARD.items():
+        a = plates[name].angle
+        m = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]]) @ inward
+        f = np.array([record["obstacles"][name]["fx"], record["obstacles"][name]["fy"]])
+        out[f"{name}_normal"] = float(-f @ m)
+        out[f"{name}_tangential"] = float(f @ np.array([-m[1], m[0]]))
+    return out

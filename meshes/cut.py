@@ -30,6 +30,7 @@ __all__ = [
     "two_blocks_cut_scene",
     "incline_cut_scene",
     "cut_counts",
+    "fitted_or_cut",
 ]
 
 
@@ -263,6 +264,18 @@ def cut_counts(scene: Scene) -> dict[str, int]:
         b.name: scene.mesh.comm.allreduce(int(np.sum(owned & cut & (tags == b.tag))))
         for b in scene.bodies
     }
+
+
+def fitted_or_cut(run, fitted, cut, h, quads, **geometry):
+    """A demo's scene by its --discretization, timed as the "mesh" phase: conforming,
+    fitted(comm, h=h, quads=quads, **geometry) (gmsh); cut, cut(comm, h=h, **geometry) on one
+    uniform grid, its cut cells per body in metrics["mesh"]["cut_cells"]."""
+    with run.phase("mesh"):
+        if run.params["discretization"] == "conforming":
+            return fitted(run.comm, h=h, quads=quads, **geometry)
+        scene = cut(run.comm, h=h, **geometry)
+        run.metrics["mesh"]["cut_cells"] = cut_counts(scene)
+        return scene
 
 
 if __name__ == "__main__":

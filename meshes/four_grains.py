@@ -197,3 +197,29 @@ def four_grains(
         bodies.append((name, 10 + m, shape))
     build = grid_scene(comm, lines, lines, [(b[0], b[1]) for b in bodies], contact_box=False)
     return (lines, lines), bodies, build, {name: face for name, (_, face) in plates.items()}
+
+
+def checked_outlines(radius, seed, h, overlap, clearance, travel):
+    """The options of demos/four_grains.py checked, then grain_outlines(radius, seed, overlap)
+    (numpy only, ~0.5 s: before any output); a ValueError names the option: seed in [0, 2^31),
+    5 <= radius/h <= 200, overlap <= h/2, the plates' total travel <= 0.05 radius, a seed
+    whose arrangement closes, contact zones on the plates (check_contact_zones)."""
+    if not 0 <= seed < 2**31:
+        raise ValueError(f"--seed: must be in [0, 2^31), got {seed}")
+    if not 5 <= radius / h <= 200:
+        raise ValueError(f"--h: must give 5 <= radius/h <= 200 (radius {radius:g}), got {h}")
+    if not overlap <= 0.5 * h:
+        raise ValueError(f"--overlap: must be in (0, h/2] = (0, {0.5 * h:g}], got {overlap}")
+    if not travel <= 0.05 * radius:
+        raise ValueError(
+            f"--displacement: steps x displacement must be <= 0.05 radius = {0.05 * radius:g}"
+        )
+    try:
+        outlines = grain_outlines(radius, seed, overlap)
+    except ValueError as e:
+        raise ValueError(f"--seed: {e}") from None
+    try:
+        check_contact_zones(*outlines[:2], h, overlap, clearance)
+    except ValueError as e:
+        raise ValueError(f"--h: {e}") from None
+    return outlines

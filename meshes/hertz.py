@@ -90,6 +90,87 @@ def check_mesh_size(R, width, depth, h, zone, Ry=None):
         )
 
 
+# fmt: off
+#: demos/hertz.py's options of the scene's sizes (cli.add_options rows), interpreted by
+#: demo_sizes, demo_band and scene_sizes; a: the Hertz half-width of --load, --R, --E
+SIZE_OPTIONS = [
+    ("--band", "(0, inf)", None,
+     "largest initial gap covered by the contact surface (default: the gap at x = 1.6 a)"),
+    ("--width", "(0, inf)", None, "block width (default max(40, 40 a))"),
+    ("--depth", "(0, inf)", None, "block depth (default max(20, 20 a))"),
+    ("--zone", "[1, inf)", 1.2, "half-width of the zone meshed at h, in units of the Hertz a"),
+    ("--h-far", "(0, inf)", None,
+     "mesh size far from the contact (default min(R / 2, depth / 2, 100 h))"),
+    ("--grading", "(0, inf)", None,
+     "size growth away from the zone: slope (body-fitted, default 0.25) or ratio of "
+     "neighbouring cells (cut, > 1, default 2)"),
+]
+#: and of its mesher, checked by demo_sizes
+MESHER_OPTIONS = [
+    ("--quads", bool, False, "quadrilateral cells"),
+    ("--mesher", list(MESHERS), "gmsh",
+     "body-fitted mesher: gmsh, or layers (triangles in layers around the contact point, "
+     "no gmsh)"),
+]
+# fmt: on
+
+
+def demo_sizes(args, hertz_a):
+    """demos/hertz.py's mesher options checked (the layers: body-fitted triangles only; a cut
+    grid's growth ratio --grading > 1), then its sizes that default from the Hertz half-width
+    hertz_a (--width max(40, 40 a), --depth max(20, 20 a), --h a/20; --zone in units of a)
+    and what the scenes can mesh: the zone inside both bodies, h within mesh_size_bounds.
+    Returns (width, depth, h); a ValueError names the option to change."""
+    a, cut = args, args.discretization == "cut"
+    if a.mesher != "gmsh" and (cut or a.quads):
+        raise ValueError(
+            f"--mesher {a.mesher}: body-fitted triangles only (not with --quads or cut)"
+        )
+    if a.grading is not None and cut and not a.grading > 1:
+        raise ValueError(f"--grading: the cut grid's growth ratio must be > 1, got {a.grading:g}")
+    width, depth = a.width or max(40.0, 40 * hertz_a), a.depth or max(20.0, 20 * hertz_a)
+    zone = a.zone * hertz_a
+    given = "--h" if a.h is not None else "--R, --load, --E (h = a/20 of the Hertz a)"
+    h = a.h or hertz_a / 20
+    room = {"--R": a.R, "--width": width / 2, "--depth": depth}
+    name = min(room, key=room.get)
+    if not zone < room[name]:
+        raise ValueError(
+            f"{name}: the zone meshed at h, {a.zone:g} a = {zone:.4g} (a = {hertz_a:.4g}, the "
+            f"Hertz half-width of --load, --R, --E), must lie inside both bodies: "
+            f"below {name.lstrip('-')}{'/2' if name == '--width' else ''} = {room[name]:.4g}"
+        )
+    lo, hi = mesh_size_bounds(a.R, width, depth, zone)  # cells and grading gmsh can do
+    if not lo <= h <= hi:
+        raise ValueError(
+            f"{given}: h = {h:.4g} outside [{lo:.4g}, {hi:.4g}] (at least 1/2000 of the "
+            f"zone's half-width {zone:.4g} and 1e-5 of the largest body size "
+            f"{max(a.R, width, depth):.4g}, at most half the zone; a small load needs "
+            "smaller --R, --width, --depth)"
+        )
+    return width, depth, h
+
+
+def demo_band(p, hertz_a):
+    """The largest initial gap Gamma_c covers for the parameters p of demos/hertz.py: --band,
+    default the gap at x = 1.6 a."""
+    return p["band"] or (1.6 * hertz_a) ** 2 / (2 * p["R"])
+
+
+def scene_sizes(p, hertz_a):
+    """The size keywords of hertz_scene (cut: meshes.cut.hertz_cut_scene) for the parameters p
+    of demos/hertz.py: the zone meshed at h, the band (rank 0 holds the cells of Gamma_c) and
+    the defaults of h_far and growth."""
+    cut = p["discretization"] == "cut"
+    zone, band = p["zone"] * hertz_a, demo_band(p, hertz_a)
+    # the far field coarsens with h, so that its error falls with h's (fixed h_far: a floor)
+    h_far = p["h_far"] or min(p["R"] / 2, p["depth"] / 2, 100 * p["h"])
+    # body-fitted slope 0.5 instead: the same error at a/20 but a floor of 0.55 % from a/40
+    growth = p["grading"] or (2.0 if cut else 0.25)
+    size = {k: p[k] for k in ("R", "width", "depth", "h")}
+    return dict(size, zone=zone, band=band, h_far=h_far, growth=growth)
+
+
 def ellipse_sag(R, Ry, x):
     """Height of the arc above its lowest point at abscissa x: Ry (1 - sqrt(1 - (x/R)^2)) (the
     initial gap to the block top; R - sqrt(R^2 - x^2) for the circle Ry = R)."""

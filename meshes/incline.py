@@ -72,6 +72,27 @@ def incline_scene(comm, h=25.0, quads=False, size=1000.0, slope=0.2, intercept=4
         return scene_from_gmsh(comm, bodies, markers, [(0, 1)], h, contact_box=box)
 
 
+#: the supports of demos/inclined_interface.py: --supports help, and what metrics.json records
+SUPPORTS_HELP = (
+    "uniaxial: u_x of the uniform uniaxial state on top and bottom; held: top u_x = 0, bottom on "
+    "rollers with its middle point fixed"
+)
+SUPPORTS = {
+    "uniaxial": "top: u_y = -d, u_x = e_xx (x - 500); bottom: u_y = 0, u_x = e_xx (x - 500); "
+    "sides free (e_xx: lateral strain of the uniform uniaxial state, penalty compliance included)",
+    "held": "top: u_y = -d, u_x = 0; bottom: u_y = 0 (rollers), u_x = 0 at the bottom vertex "
+    "nearest to (500, 0); sides free",
+}
+
+
+def bottom_vertex(mesh, x0):
+    """The marker of the vertex on the bottom y = 0 nearest to (x0, 0) (the held supports'
+    fixed point of demos/inclined_interface.py)."""
+    from dolfinx_forms.fem.boundary import nearest_vertex_marker
+
+    return nearest_vertex_marker(mesh, (x0, 0.0), lambda x: np.isclose(x[1], 0.0))
+
+
 if __name__ == "__main__":
     import argparse
 

@@ -3,7 +3,9 @@
 `grid_scene(comm, xlines, ylines, bodies, ...)` returns the `build_scene(levelsets)` callback of
 `dolfinx_forms.mpm.implicit.ImplicitMPM`: every step it makes the cut scene of the current level
 sets (each body's window is the whole grid: only its level set decides its active cells). Also the
-Brazilian-disc set-up (paper 5.3.1): a disc between two rigid half-plane platens.
+Brazilian-disc set-up (paper 5.3.1): a disc between two rigid half-plane platens, with the checks
+of its demo's options; the nine discs in four plates (5.2.1), with the D4 symmetry check of the
+answer (d4_symmetry_error).
 """
 
 from __future__ import annotations
@@ -76,6 +78,29 @@ def brazilian_disc(comm, R=10.0, h=0.2, step_displacement=0.02, steps=50, margin
     return (xl, yl), ("disc", 1, df.Circle((0.0, 0.0), R)), [top, bottom], build
 
 
+def check_brazilian_disc(R, h, steps, step_displacement):
+    """ValueError (its message names the option) unless the grid has 10 to 4000 cells across
+    the disc, the platens' total travel stays small-strain and one step stays within h/2."""
+    if not h <= R / 5:
+        raise ValueError(
+            f"--h: must be in (0, R/5] = (0, {R / 5:g}] (at least 10 cells across), got {h}"
+        )
+    if not R / h <= 2000:
+        raise ValueError(
+            f"--h: must be >= R/2000 = {R / 2000:g} (grid of at most 4000^2 cells), got {h}"
+        )
+    if not steps * step_displacement <= 0.2 * R:
+        raise ValueError(
+            f"--step-displacement: steps x step must be <= 0.2 R = {0.2 * R:g} "
+            f"(small-strain MPM), got {steps * step_displacement:g}"
+        )
+    if not step_displacement <= 0.5 * h:
+        raise ValueError(
+            f"--step-displacement: must be <= h/2 = {0.5 * h:g} per step (contact band "
+            f"and level-set advection), got {step_displacement}"
+        )
+
+
 def disc_column(comm, n=5, R=10.0, h=0.5, step_displacement=0.05, steps=20, margin=None):
     """n identical discs of radius R stacked on x = 0 (centres 2 R k, k = 0..n-1, touching)
     between a fixed lower platen (y < -R) and an upper one (y > (2 n - 1) R) moved down by
@@ -143,6 +168,54 @@ def nine_discs(comm, R=1.7, plate=(1.0, 9.8), h=0.1, overlap=1e-3, margin=None):
         bodies.append((name, 10 + m, shape))
     build = grid_scene(comm, lines, lines, [(b[0], b[1]) for b in bodies], contact_box=False)
     return (lines, lines), bodies, build, {name: face for name, (_, face) in plates.items()}
+
+
+#: the symmetry group of the square (nine_discs): 4 rotations, 4 reflections
+D4 = [
+    np.array(m, float)
+    for m in (
+        [[1, 0], [0, 1]],
+        [[0, -1], [1, 0]],
+        [[-1, 0], [0, -1]],
+        [[0, 1], [-1, 0]],
+        [[-1, 0], [0, 1]],
+        [[1, 0], [0, -1]],
+        [[0, 1], [1, 0]],
+        [[0, -1], [-1, 0]],
+    )
+]
+
+
+def d4_symmetry_error(sim, rec, h):
+    """Largest relative differences of the nine-disc scene's answer under D4: contact forces
+    (by the contact's centre) and the stress at the material points (by position: their images
+    within 1e-4 h; from step 2 on the points move with a field that is D4-symmetric only to the
+    MLS projection's error). Returns (forces, stresses, largest distance of a contact centre's
+    image to a centre, fraction of the points compared)."""
+    from scipy.spatial import cKDTree
+
+    act = [q for q in rec["pairs"] if q["normal_force"] > 0]
+    c = np.array([[q["x"], q["y"]] for q in act])
+    fn = np.array([q["normal_force"] for q in act])
+    ft = np.abs([q["tangential_force"] for q in act])
+    x = np.concatenate([p.x for p in sim.points.values()])
+    s = np.concatenate([p.stress for p in sim.points.values()])
+    S = np.stack([np.stack([s[:, 0], s[:, 2]], 1), np.stack([s[:, 2], s[:, 1]], 1)], 1)
+    tc, tx = cKDTree(c), cKDTree(x)
+    e_f = e_s = e_x = 0.0
+    n_same = len(x)
+    for G in D4:
+        d, k = tc.query(c @ G.T)
+        e_x = max(e_x, d.max())
+        e_f = max(e_f, np.max(np.abs(fn[k] - fn)), np.max(np.abs(ft[k] - ft)))
+        # stresses at the points whose image is a point: those of the interior cells' tensor
+        # Gauss rule (the cut cells' sub-triangle rule is not D4-invariant)
+        d, k = tx.query(x @ G.T)
+        same = d < 1e-4 * h
+        Sg = np.einsum("ab,nbc,dc->nad", G, S, G)
+        e_s = max(e_s, np.max(np.abs(S[k[same]] - Sg[same]), initial=0.0))
+        n_same = min(n_same, int(same.sum())) if G is not D4[0] else int(same.sum())
+    return e_f / fn.max(), e_s / np.abs(S).max(), e_x, n_same / len(x)
 
 
 def plate_face_conditions(faces, displacement):

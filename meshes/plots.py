@@ -1,0 +1,133 @@
+"""The demos' figures beyond the shared traction plot (dolfinx_forms.io.output): each function
+writes the PNG files of one demo into its result folder. matplotlib is imported on first use
+(Agg backend), so importing this module costs nothing."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dolfinx_forms.app.mpm_run import binned_mean, plot_force_chains
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(plt, fig, path, tight=True):
+    if tight:
+        fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def brazilian_disc_plots(run, folder, half_width):
+    """demos/brazilian_disc.py: half_width.png (the platens' contact half-widths against
+    half_width(F, R, E, nu), Hertz) and sigma_yy.png (sigma_yy at the material points, four
+    frames of the time series)."""
+    plt = _pyplot()
+    p, rows = run.params, run.rows
+    F = np.array([r["force_top"] for r in rows])
+    Fs = np.linspace(0, F.max(), 200)
+    fig, ax = plt.subplots(figsize=(5, 4))
+    ax.plot(Fs, half_width(Fs, p["R"], p["E"], p["nu"]), "k-", label="Hertz")
+    ax.plot(F, [r["half_width_top"] for r in rows], "o", ms=3, label="top platen")
+    ax.plot(F, [r["half_width_bottom"] for r in rows], "x", ms=3, label="bottom platen")
+    ax.axhline(5 * p["h"], color="0.6", ls=":", label="5 h")
+    ax.set(xlabel="F (N/mm)", ylabel="a (mm)", title="Brazilian disc: contact half-width")
+    ax.legend()
+    _save(plt, fig, folder / "half_width.png")
+    frames = run.data["series"]["disc"].frames  # (step, x, {stress, ...}, cells)
+    frames = [
+        frames[k] for k in sorted({0, len(frames) // 3, 2 * len(frames) // 3, len(frames) - 1})
+    ]
+    fig, axes = plt.subplots(1, len(frames), figsize=(3.2 * len(frames), 3.4), squeeze=False)
+    lo = min(f[2]["stress"][:, 1].min() for f in frames)
+    for ax, (step, x, data, _) in zip(axes[0], frames):
+        image, extent = binned_mean(x, data["stress"][:, 1], p["h"])
+        sc = ax.imshow(image, extent=extent, origin="lower", cmap="viridis", vmin=lo, vmax=0)
+        ax.set(aspect="equal", title=f"step {step:g}", xticks=[], yticks=[])
+    fig.colorbar(sc, ax=axes[0].tolist(), label="sigma_yy at the material points (N/mm^2)")
+    _save(plt, fig, folder / "sigma_yy.png", tight=False)
+
+
+def max_principal(s):
+    """Largest principal stress of [s_xx, s_yy, s_xy] rows."""
+    return 0.5 * (s[:, 0] + s[:, 1]) + np.hypot(0.5 * (s[:, 0] - s[:, 1]), s[:, 2])
+
+
+def four_grains_plots(run, folder):
+    """demos/four_grains.py: force_chains.png and max_principal_stress.png (the largest
+    principal stress at the material points, the active contacts' centres marked)."""
+    plt = _pyplot()
+    sim, rec = run.sim, run.records[-1]
+    plot_force_chains(sim, rec, folder / "force_chains.png", "four grains")
+    x = np.concatenate([p.x for p in sim.points.values()])
+    s1 = max_principal(np.concatenate([p.stress for p in sim.points.values()]))
+    lim = np.percentile(np.abs(s1), 99.5)  # the contact peaks would wash out the rest
+    fig, ax = plt.subplots(figsize=(6, 6))
+    image, extent = binned_mean(x, s1, sim.h)
+    sc = ax.imshow(image, extent=extent, origin="lower", cmap="RdBu_r", vmin=-lim, vmax=lim)
+    for q in rec["pairs"]:
+        if q["normal_force"] > 0:
+            ax.plot(q["x"], q["y"], "k+", ms=6)
+    fig.colorbar(sc, ax=ax, label="largest principal stress (N/mm^2)", shrink=0.8)
+    ax.set(aspect="equal", title=f"four grains: largest principal stress, step {rec['step']}")
+    _save(plt, fig, folder / "max_principal_stress.png")
+
+
+def grain_assembly_plots(run, folder):
+    """demos/grain_assembly.py: force_chains.png and plate_forces.png (normal and tangential
+    forces on the top and left plates per step; dotted: the end of compression)."""
+    plt = _pyplot()
+    plot_force_chains(run.sim, run.records[-1], folder / "force_chains.png", "grain assembly")
+    fig, ax = plt.subplots(figsize=(6, 4))
+    steps = [r["step"] for r in run.rows]
+    for name in ("plate_top", "plate_left"):
+        ax.plot(steps, [r[f"{name}_normal"] for r in run.rows], "-", label=f"{name} normal")
+        ax.plot(
+            steps, [r[f"{name}_tangential"] for r in run.rows], "--", label=f"{name} tangential"
+        )
+    ax.axvline(run.params["steps"] + 0.5, color="0.6", ls=":")
+    ax.set(xlabel="step", ylabel="force (N/mm)", title="plate forces (compression | shear)")
+    ax.legend(fontsize=8)
+    _save(plt, fig, folder / "plate_forces.png")
+
+
+def contact_geometry_plot(run, path):
+    """demos/contact_geometry.py: the bodies' zero contours and Gamma_c's segments (left), the
+    computed initial gaps g_n0 against the exact ones (right)."""
+    plt = _pyplot()
+    d, sc = run.data, run.scene
+    s, x = d["s"], d["s"]["points"]
+    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
+    X = sc.grid.nodes().reshape(sc.grid.shape + (2,))
+    ax[0].contour(X[..., 0], X[..., 1], sc.block.values, [0], colors="k")
+    ax[0].contour(X[..., 0], X[..., 1], sc.cyl.values, [0], colors="b")
+    for seg in s["segments"]:
+        ax[0].plot(seg[:, 0], seg[:, 1], "g-")
+    ax[0].set_aspect("equal")
+    ax[0].set_title("bodies (black, blue) and $\\Gamma_c$ (green)")
+    ax[1].plot(x[:, 0], d["g_n0"], "g.", label="computed $g_{n0}$")
+    order = np.argsort(x[:, 0])
+    ax[1].plot(x[order, 0], d["exact"][order], "k-", lw=0.8, label="exact")
+    ax[1].set(xlabel="x (mm)", ylabel="initial normal gap $g_{n0}$ (mm), eq 28")
+    ax[1].legend()
+    _save(plt, fig, path)
+
+
+def slip_plot(run, folder):
+    """demos/inclined_interface.py: slip.png, the plastic slip g_t^p and the total tangential
+    jump g_t along the interface (dotted: the end margins h from the sides x = 0, size)."""
+    from dolfinx_forms.io.output import plot_lines
+
+    (gt_x, gt), h, pts, size = run.data["g_t"], run.params["h"], run.pts, run.params["size"]
+    o = np.argsort(gt_x)
+    lines = {"total jump g_t": (gt_x[o], gt[o], "-")}
+    lines["plastic slip g_t^p"] = (pts["x"], pts["slip"], ".")
+    title, margins = f"{run.data['verdict']}; dotted: end margin h", (h, size - h)
+    plot_lines(folder / "slip.png", lines, title, ylabel="tangential jump (mm)", vlines=margins)
