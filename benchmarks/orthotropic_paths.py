@@ -59,7 +59,11 @@ from meshes.hertz import ellipse_sag, hertz_scene
 ROOT = Path(__file__).resolve().parents[1]
 
 GEOMETRY = dict(R=10.0, Ry=6.0, width=40.0, depth=20.0, zone=1.6)
-ORTHO = dict(E1=2.0e4, E2=1.0e4, E3=1.0e4, nu12=0.25, nu13=0.3, nu23=0.3, G12=5.0e3, angle=0.3)
+# angle in degrees (0.3 rad)
+ORTHO = dict(
+    E1=2.0e4, E2=1.0e4, E3=1.0e4, nu12=0.25, nu13=0.3, nu23=0.3, G12=5.0e3,
+    angle=float(np.degrees(0.3)),
+)  # fmt: skip
 ISO = dict(E=1.0e4, nu=0.3)
 DELTA = 0.1  # approach of the indenter top (a ~ 1, Fy ~ 300 N/mm)
 EPS0 = 0.5

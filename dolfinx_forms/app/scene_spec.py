@@ -438,8 +438,6 @@ def make_law(law):
     from dolfinx_forms.fem.laws import LAWS
 
     params = {k: v for k, v in law.items() if k != "type"}
-    if "angle" in params:
-        params["angle"] = math.radians(params["angle"])
     return LAWS[law["type"]](**params)
 
 
@@ -755,10 +753,29 @@ def validate(data, base_dir=None, default_name="scene"):
     return spec
 
 
+# the discretization keys one kind reads and the other refuses
+KIND_ONLY = {"cut": ("extent", "growth", "cells"), "fitted": ("slope", "structured")}
+
+
 def apply_overrides(data, overrides):
     """Set values given as 'a.b[1].c=VALUE' (VALUE in TOML syntax, or a bare string) in a copy
-    of `data`; tables on the way are created."""
+    of `data`; tables on the way are created. An override that switches discretization.kind
+    drops the description's own keys of the other kind (KIND_ONLY; the quadrilateral cell and
+    degree 1 a cut grid requires), so that `--set discretization.kind="fitted"` runs a cut
+    scene body-fitted; keys given by --set are kept (and checked)."""
     data = copy.deepcopy(data)
+    before = data.get("discretization", {}).get("kind") if isinstance(data, dict) else None
+    data = _apply(data, overrides)
+    d = data.get("discretization") if isinstance(data, dict) else None
+    if isinstance(d, dict) and before is not None and d.get("kind") not in (None, before):
+        given = {i.partition("=")[0].strip() for i in overrides}
+        for k in KIND_ONLY.get(before, ()) + (("cell", "degree") if d["kind"] == "cut" else ()):
+            if f"discretization.{k}" not in given:
+                d.pop(k, None)
+    return data
+
+
+def _apply(data, overrides):
     for item in overrides:
         key, sep, text = item.partition("=")
         key = key.strip()

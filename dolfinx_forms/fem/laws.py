@@ -78,7 +78,8 @@ class LinearElastic(IsotropicLaw):
 class OrthotropicElastic(Law):
     """Orthotropic linear elasticity in plane strain (eps_33 = 0).
 
-    Material axes 1, 2 in the plane, rotated by `angle` (radians, counter-clockwise) from x, y;
+    Material axes 1, 2 in the plane, rotated by `angle` (degrees, counter-clockwise: the unit
+    of every angle a user gives, here and in scene descriptions) from x, y;
     axis 3 out of plane. Engineering constants E1, E2, E3, Poisson ratios nu12, nu13, nu23
     (nu_ij = -eps_j / eps_i under uniaxial stress i) and in-plane shear modulus G12. The
     in-plane stiffness is the 2x2 block of the inverse of the 3x3 normal compliance (plane
@@ -101,12 +102,12 @@ class OrthotropicElastic(Law):
         C = np.linalg.inv(S)
         self.E1, self.E2, self.E3 = float(E1), float(E2), float(E3)
         self.nu12, self.nu13, self.nu23 = float(nu12), float(nu13), float(nu23)
-        self.G12, self.angle = float(G12), float(angle)
+        self.G12, self.angle = float(G12), float(angle)  # degrees
         self.C11, self.C12, self.C22 = float(C[0, 0]), float(C[0, 1]), float(C[1, 1])
         self.modulus, self.p_modulus = max(E1, E2), max(self.C11, self.C22)
 
     def stress(self, u):
-        c, s = np.cos(self.angle), np.sin(self.angle)
+        c, s = np.cos(np.radians(self.angle)), np.sin(np.radians(self.angle))
         R = ufl.as_matrix([[c, -s], [s, c]])  # columns: material axes in x, y
         e = R.T * strain(u) * R
         sm = ufl.as_matrix(

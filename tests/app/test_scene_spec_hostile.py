@@ -107,3 +107,13 @@ def test_touching_bodies_are_not_an_overlap():
     point (Hertz) pass."""
     for name in ("two_blocks", "patch", "hertz", "mindlin", "disc_squeeze"):
         assert load(ROOT / "demos" / "scenes" / f"{name}.toml")["name"] == name
+
+
+def test_set_switches_the_discretization_kind():
+    """--set discretization.kind="fitted" on a cut scene drops the file's cut-only keys (it
+    was refused: "extent: not used by kind = 'fitted'"); the same keys given by --set are
+    still checked."""
+    spec = load(PATCH, ['discretization.kind="fitted"'])
+    assert spec["discretization"]["kind"] == "fitted" and "extent" not in spec["discretization"]
+    with pytest.raises(SpecError, match="^discretization.extent: not used by kind = 'fitted'"):
+        load(PATCH, ['discretization.kind="fitted"', "discretization.extent=[[0,0],[1,1]]"])

@@ -1,7 +1,7 @@
 """Acceptance: the same orthotropic UFL law on a cut body and on a body-fitted body.
 
 A half-ellipse (semi-axes R = 10 horizontal, Ry = 6 vertical) pressed onto a block, both
-bodies `OrthotropicElastic(E1=2e4, E2=E3=1e4, nu12=0.25, nu13=nu23=0.3, G12=5e3, angle=0.3)`,
+bodies `OrthotropicElastic(E1=2e4, E2=E3=1e4, nu12=0.25, nu13=nu23=0.3, G12=5e3, angle=0.3 rad)`,
 frictionless, the same approach delta = 0.1 on both paths (a ~ 1.0, Fy ~ 299.4 N/mm), at
 h = 0.2, 0.1, 0.05 (a/h = 5, 10, 20; h_far = 8 h, so every cell halves): body-fitted P1
 triangles (meshes.hertz.hertz_scene, gmsh ellipse arc) against Q1 on the cut grid
