@@ -252,7 +252,8 @@ def plot_force_chains(sim, record, path, title="force chains"):
     """The force network of one step: segments from the centroids of the two bodies of every
     pair with a normal force to the centre of its contact zone (width by normal force; a wall's
     or obstacle's side is left out when its centroid lies far from the contact), over the mean
-    stress (s_xx + s_yy) / 2 at the material points (clipped at its 2nd percentile)."""
+    stress (s_xx + s_yy) / 2 at the material points (clipped at its 2nd percentile), with the
+    bodies' outlines (blue) and the rigid obstacles' (green) on the grid."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -270,6 +271,16 @@ def plot_force_chains(sim, record, path, title="force chains"):
     # the points' mean per pixel of about h (4 points): a scatter of ~1e5 markers took 1-2 s
     image, extent = binned_mean(x, mean, sim.h)
     sc = ax.imshow(image, extent=extent, origin="lower", cmap="Greys_r", vmin=lo, vmax=0)
+    # the bodies' outlines (their level sets' zero contours) and the rigid obstacles'
+    X, Y = np.meshgrid(sim.xlines, sim.ylines)
+    for b in sim.bodies:
+        phi = np.asarray(sim.levelsets[b.tag].values).reshape(X.shape)
+        ax.contour(X, Y, phi, [0.0], colors="tab:blue", linewidths=0.6)
+    xy = np.c_[X.ravel(), Y.ravel()]
+    for ob in getattr(sim, "obstacles", ()):
+        phi = np.asarray(ob.values(xy)).reshape(X.shape)
+        if phi.min() < 0 < phi.max():
+            ax.contour(X, Y, phi, [0.0], colors="tab:green", linewidths=1.2)
     fmax = max([q["normal_force"] for q in record["pairs"]] + [1e-300])
     for q in record["pairs"]:
         if q["normal_force"] <= 0:
