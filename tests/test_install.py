@@ -33,6 +33,7 @@ SCRIPT = textwrap.dedent(
     import dolfinx_forms
     import meshes
     from dolfinx_forms import _cpp
+    from dolfinx_forms.solvers.options import ContactOptions
     from dolfinx_forms.solvers.problem import ContactProblem
     from meshes.cut import patch_cut_scene
     from meshes.patch import patch_dirichlet
@@ -42,8 +43,9 @@ SCRIPT = textwrap.dedent(
         assert Path(mod.__file__).resolve().is_relative_to(venv), mod.__file__
     E, nu, d, n = 1.0, 0.3, 0.01, 5
     scene = patch_cut_scene(MPI.COMM_WORLD, n=n, interface=0.5)  # a row of cut cells
-    p = ContactProblem(scene, {b.tag: (E, nu) for b in scene.bodies}, mu=0.0, eps0=1.0,
-                       band=0.5 / n, dirichlet=patch_dirichlet(d), log=lambda *a, **k: None)
+    p = ContactProblem(scene, {b.tag: (E, nu) for b in scene.bodies},
+                       contact=ContactOptions(mu=0.0, eps0=1.0, band=0.5 / n),
+                       dirichlet=patch_dirichlet(d), log=lambda *a, **k: None)
     p.solve(1)
     pn = np.abs(np.concatenate([q["p_n"] for q in p.contact_points()]))
     Ep = E / (1 - nu**2)
