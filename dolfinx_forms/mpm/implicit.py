@@ -254,6 +254,8 @@ class ImplicitMPM:
         record.update(
             step=self.step_count,
             newton_iterations=int(sum(s.iterations for s in problem.steps)),
+            # |R| of every Newton iteration of the accepted solve (a cut-back's are dropped)
+            residuals=[float(r) for s in problem.steps for r in s.residuals],
             cutbacks=int(sum(s.cutback for s in problem.steps)),
             num_dofs=int(imap.size_global * problem.bs),
             num_cells=int(scene.mesh.topology.index_map(2).size_global),
