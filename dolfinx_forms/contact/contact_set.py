@@ -59,6 +59,7 @@ Its multipliers are left unclipped too.
 import numpy as np
 
 from dolfinx_forms import _cpp
+from dolfinx_forms.contact.multipliers import Multipliers
 from dolfinx_forms.contact.resultants import traction_resultant
 from dolfinx_forms.geometry.pairs import pair_geometry
 
@@ -71,7 +72,7 @@ def pair_key(pair, obstacle=None):
     return (int(pair[0]), obstacle.name) if obstacle is not None else (int(pair[0]), int(pair[1]))
 
 
-class ContactSet:
+class ContactSet(Multipliers):
     """Contact points of `scene.pairs` on rank `rank` (empty elsewhere; or a {pair_key: rank}
     map: each pair on its own rank, the others on rank 0; the cells of a pair may be ghost
     cells there: its dofs are local indices, ghosts included, and the residual and tangent
@@ -118,14 +119,7 @@ class ContactSet:
         self.eps_t_start = self.eps_t if eps_t_start is None else float(eps_t_start)
         if not self.eps_t_start >= self.eps_t:
             raise ValueError(f"eps_t_start must be >= eps_t = {eps_t!r}, got {eps_t_start!r}")
-        self.pairs = []
         self.obstacles = list(obstacles)
-
-        # rank: the rank that computes every pair, or {pair key: rank} (pair_key; others on 0)
-        def owner(key):
-            return rank.get(key, 0) if isinstance(rank, dict) else rank
-
-        me = V.mesh.comm.rank
         kw = dict(
             grid_refine=grid_refine,
             num_gauss=num_gauss,
@@ -135,20 +129,7 @@ class ContactSet:
             traction=traction,
             multiplier_mass=multiplier_mass,
         )
-        candidates = [(tuple(pair), None) for pair in scene.pairs] + [
-            ((i, -1), ob)
-            for ob in self.obstacles
-            for i, b in enumerate(scene.bodies)
-            if ob.bodies is None or b.tag in np.atleast_1d(ob.bodies)
-        ]
-        self.index = []  # of each pair held here in the candidates (scene.pairs, then obstacles)
-        for c, (pair, ob) in enumerate(candidates):
-            if owner(pair_key(pair, ob)) != me:
-                continue
-            g = pair_geometry(V, scene, pair, band, obstacle=ob, **kw)
-            if g is not None:
-                self.pairs.append(g)
-                self.index.append(c)
+        self.pairs, self.index = build_pairs(V, scene, band, rank, self.obstacles, kw)
         self._lam = None
         # friction history, slip origin and multipliers live at the law points (the multiplier
         # nodes, or the points): `PairGeometry.num_law_points`
@@ -212,11 +193,6 @@ class ContactSet:
     def augmented(self):
         return self.enforcement == "augmented"
 
-    def _committed_tractions(self, k):
-        c = self.committed[k]
-        zero = np.zeros(self.pairs[k].num_law_points)
-        return (zero, zero) if c is None else (c["law_tau_n"], c["law_tau_t"])
-
     def _slip_read(self, k):
         """The slip the kernel reads: the committed one, shifted in the augmented loop so that
         tau_t,trial = lambda_t + (g_t - g_t,start) / eps_t (g_t,start = gtp_c + eps_t tau_c)."""
@@ -243,70 +219,6 @@ class ContactSet:
             closed_gap,
             shift,
         )
-
-    def start_step(self):
-        """Multipliers of a new step (or a retried one): the committed tractions; eps_t its
-        loop's first."""
-        self.eps_t = self.eps_t_start
-        for k in range(len(self.pairs)):
-            tn, tt = self._committed_tractions(k)
-            self.lambda_n[k], self.lambda_t[k] = tn.copy(), tt.copy()
-
-    def multipliers(self):
-        """The multipliers of all pairs on this rank as one vector [lambda_n..., lambda_t...]
-        (lambda_t only with friction)."""
-        parts = self.lambda_n + (self.lambda_t if self.mu > 0 else [])
-        return np.concatenate(parts) if parts else np.zeros(0)
-
-    def set_multipliers(self, x):
-        n = [g.num_law_points for g in self.pairs]
-        cuts = np.cumsum(n)[:-1] if n else []
-        self.lambda_n = [a.copy() for a in np.split(x[: sum(n)], cuts)]
-        if self.mu > 0:
-            self.lambda_t = [a.copy() for a in np.split(x[sum(n) :], cuts)]
-
-    def admissible(self, x):
-        """x (laid out as `multipliers`) projected on the admissible tractions: lambda_n <= 0,
-        |lambda_t| <= mu |lambda_n| (an extrapolated update may leave them)."""
-        n = sum(g.num_law_points for g in self.pairs)
-        # with the consistent projection a fixed point has small tensile multipliers just past
-        # the contact edge (the L2 fit of the pressure's edge; the law clips the traction):
-        # clipping them at the points stalls the loop, so its pairs are left as they are (the
-        # hybrid's consistent rows likewise)
-        free = np.concatenate(
-            [np.full(g.num_law_points, g.multiplier_mass != "lumped") for g in self.pairs]
-            or [np.zeros(0, bool)]
-        )
-        x = x.copy()
-        x[:n] = np.where(free, x[:n], np.minimum(x[:n], 0.0))
-        if self.mu > 0:
-            bound = self.mu * np.abs(x[:n])
-            x[n:] = np.where(free, x[n:], np.clip(x[n:], -bound, bound))
-        return x
-
-    def freeze_rows(self, freeze=True):
-        """multiplier_mass "hybrid": keep (True) which nodes have consistent rows, as the last
-        projection chose them, or choose them afresh at every projection again (False). The
-        Uzawa loop freezes them where it cycles (`newton.augmented_loop`): a row that switches
-        as points open and close makes the update discontinuous, which can have no fixed
-        point; frozen, the projection is linear."""
-        for g in self.pairs:
-            if g.multiplier_mass == "hybrid":
-                g.frozen_rows = g.hybrid_rows if freeze else None
-
-    def tractions(self):
-        """The tractions of the last evaluation, laid out as `multipliers` (Uzawa's T); with
-        traction "points" projected on the multiplier nodes and interpolated back."""
-
-        def law(g, s, key):
-            if not g.law_at_points_with_nodes:
-                return s[key]
-            closed = s["law_tau_n"] < 0 if key == "law_tau_n" else None  # hybrid: normal only
-            return g.interpolate(g.node_multipliers(s[key], closed))
-
-        keys = ["law_tau_n"] + (["law_tau_t"] if self.mu > 0 else [])
-        parts = [law(g, s, key) for key in keys for g, s in zip(self.pairs, self.last)]
-        return np.concatenate(parts) if parts else np.zeros(0)
 
     def assemble(self, u, b, A=None, fd=False, fd_step=1e-9, closed_gap=0.0, stick=False):
         """Add the contact residual of displacement array u to the array b (local, with
@@ -415,3 +327,29 @@ class ContactSet:
                 )
             )
         return out
+
+
+def build_pairs(V, scene, band, rank, obstacles, kw):
+    """The pair geometries this rank holds (`geometry.pairs.pair_geometry`) and, for each, its
+    index among the candidates (scene.pairs, then each obstacle with each body it may touch).
+    rank: the rank that computes every pair, or {pair key: rank} (pair_key; others on 0)."""
+
+    def owner(key):
+        return rank.get(key, 0) if isinstance(rank, dict) else rank
+
+    me = V.mesh.comm.rank
+    candidates = [(tuple(pair), None) for pair in scene.pairs] + [
+        ((i, -1), ob)
+        for ob in obstacles
+        for i, b in enumerate(scene.bodies)
+        if ob.bodies is None or b.tag in np.atleast_1d(ob.bodies)
+    ]
+    pairs, index = [], []
+    for c, (pair, ob) in enumerate(candidates):
+        if owner(pair_key(pair, ob)) != me:
+            continue
+        g = pair_geometry(V, scene, pair, band, obstacle=ob, **kw)
+        if g is not None:
+            pairs.append(g)
+            index.append(c)
+    return pairs, index

@@ -1,0 +1,81 @@
+"""The augmented Lagrangian's multipliers of a contact set (seed 003's Uzawa loop, driven by
+`solvers.newton.augmented_loop`): per pair and law point, lambda_n and lambda_t, started each
+step from the committed tractions; their vector layout for the loop, the admissible set
+(lambda_n <= 0, |lambda_t| <= mu |lambda_n|), and the tractions the loop updates them to.
+`Multipliers` is the part of `contact_set.ContactSet` that owns them."""
+
+import numpy as np
+
+
+class Multipliers:
+    """Mixin of ContactSet: needs its pairs, committed, last, mu, eps_t, eps_t_start,
+    lambda_n and lambda_t."""
+
+    def _committed_tractions(self, k):
+        c = self.committed[k]
+        zero = np.zeros(self.pairs[k].num_law_points)
+        return (zero, zero) if c is None else (c["law_tau_n"], c["law_tau_t"])
+
+    def start_step(self):
+        """Multipliers of a new step (or a retried one): the committed tractions; eps_t its
+        loop's first."""
+        self.eps_t = self.eps_t_start
+        for k in range(len(self.pairs)):
+            tn, tt = self._committed_tractions(k)
+            self.lambda_n[k], self.lambda_t[k] = tn.copy(), tt.copy()
+
+    def multipliers(self):
+        """The multipliers of all pairs on this rank as one vector [lambda_n..., lambda_t...]
+        (lambda_t only with friction)."""
+        parts = self.lambda_n + (self.lambda_t if self.mu > 0 else [])
+        return np.concatenate(parts) if parts else np.zeros(0)
+
+    def set_multipliers(self, x):
+        n = [g.num_law_points for g in self.pairs]
+        cuts = np.cumsum(n)[:-1] if n else []
+        self.lambda_n = [a.copy() for a in np.split(x[: sum(n)], cuts)]
+        if self.mu > 0:
+            self.lambda_t = [a.copy() for a in np.split(x[sum(n) :], cuts)]
+
+    def admissible(self, x):
+        """x (laid out as `multipliers`) projected on the admissible tractions: lambda_n <= 0,
+        |lambda_t| <= mu |lambda_n| (an extrapolated update may leave them)."""
+        n = sum(g.num_law_points for g in self.pairs)
+        # with the consistent projection a fixed point has small tensile multipliers just past
+        # the contact edge (the L2 fit of the pressure's edge; the law clips the traction):
+        # clipping them at the points stalls the loop, so its pairs are left as they are (the
+        # hybrid's consistent rows likewise)
+        free = np.concatenate(
+            [np.full(g.num_law_points, g.multiplier_mass != "lumped") for g in self.pairs]
+            or [np.zeros(0, bool)]
+        )
+        x = x.copy()
+        x[:n] = np.where(free, x[:n], np.minimum(x[:n], 0.0))
+        if self.mu > 0:
+            bound = self.mu * np.abs(x[:n])
+            x[n:] = np.where(free, x[n:], np.clip(x[n:], -bound, bound))
+        return x
+
+    def freeze_rows(self, freeze=True):
+        """multiplier_mass "hybrid": keep (True) which nodes have consistent rows, as the last
+        projection chose them, or choose them afresh at every projection again (False). The
+        Uzawa loop freezes them where it cycles (`newton.augmented_loop`): a row that switches
+        as points open and close makes the update discontinuous, which can have no fixed
+        point; frozen, the projection is linear."""
+        for g in self.pairs:
+            if g.multiplier_mass == "hybrid":
+                g.frozen_rows = g.hybrid_rows if freeze else None
+
+    def tractions(self):
+        """The tractions of the last evaluation, laid out as `multipliers` (Uzawa's T); with
+        traction "points" projected on the multiplier nodes and interpolated back."""
+
+        def law(g, s, key):
+            if not g.law_at_points_with_nodes:
+                return s[key]
+            closed = s["law_tau_n"] < 0 if key == "law_tau_n" else None  # hybrid: normal only
+            return g.interpolate(g.node_multipliers(s[key], closed))
+
+        keys = ["law_tau_n"] + (["law_tau_t"] if self.mu > 0 else [])
+        parts = [law(g, s, key) for key in keys for g, s in zip(self.pairs, self.last)]
+        return np.concatenate(parts) if parts else np.zeros(0)
