@@ -60,6 +60,9 @@ class MPMBody:
     shape: object
 
 
+MAX_BAND_GROWTH = 4  # doublings of the contact band within one step (16 times the start)
+
+
 def equilibrium_error(record):
     """Largest |contact + support resultant| over the bodies of a step record, relative to the
     largest normal contact force: every body's equilibrium in one number."""
@@ -133,6 +136,9 @@ class ImplicitMPM:
             )
         options(**problem_kw)  # an unknown option fails here, not at the first step
         self.problem_kw = problem_kw
+        # the contact band (the largest initial gap Gamma_c covers): the given one or 2 h to
+        # start, doubled whenever a converged step has active points near its edge (`step`)
+        self.band = float(problem_kw.pop("band", None) or 2 * self.h)
         self.points = None  # {tag: MaterialPoints}, seeded on the first scene
         self.friction = {}  # pair key -> (points (n, 2), elastic tangential gap (n,))
         self.step_count = 0
@@ -171,13 +177,33 @@ class ImplicitMPM:
     # ------------------------------------------------------------------ one step
     def step(self):
         """One load step (module docstring). Returns the step record (dict). On failure
-        (ContactSolverError, RuntimeError) the state is restored and the error re-raised."""
+        (ContactSolverError, RuntimeError) the state is restored and the error re-raised.
+        A converged step whose active contact points reach the edge of the contact band (an
+        initial gap above 0.9 band: Gamma_c may cut the contact zone off) is done again from
+        the same state with the band doubled, up to MAX_BAND_GROWTH times; the record says
+        which band it used (`band`)."""
         snap = self.snapshot()
-        try:
-            return self._step()
-        except Exception:
+        for attempt in range(MAX_BAND_GROWTH + 1):
+            try:
+                record = self._step()
+            except Exception:
+                self.restore(snap)
+                raise
+            if attempt == MAX_BAND_GROWTH or not self.band_reached():
+                record["band"] = self.band
+                return record
             self.restore(snap)
-            raise
+            self.band *= 2.0
+            self.log(f"contact band doubled to {self.band:.4g}: active points reached its edge")
+
+    def band_reached(self):
+        """Whether an active contact point of the last step has an initial gap above 0.9 band
+        (the same on every rank)."""
+        near = False
+        for g, s in zip(self.problem.contact.pairs, self.problem.contact.committed):
+            if s is not None and np.any((s["state"] > 0) & (g.g_n0 > 0.9 * self.band)):
+                near = True
+        return bool(self.comm.allreduce(near, op=MPI.LOR))
 
     def _step(self):
         t0 = time.perf_counter()
@@ -210,7 +236,7 @@ class ImplicitMPM:
                     scale=lambda lam: 1.0,
                 )
             )
-        kw = dict(self.problem_kw)
+        kw = dict(self.problem_kw, band=self.band)
         kw.setdefault("pair_grid_origin", (self.xlines[0], self.ylines[0]))
         if ranks is not None:
             kw["contact_rank"] = ranks
@@ -305,7 +331,7 @@ class ImplicitMPM:
         size = self.comm.size
         if size == 1:
             return None, None
-        band = self.problem_kw.get("band") or 2 * self.h
+        band = self.band
         X, Y = np.meshgrid(self.xlines, self.ylines)
         P = np.stack([X.ravel(), Y.ravel()], axis=1)
         near = {b.tag: self.levelsets[b.tag].values.ravel() < band for b in self.bodies}
@@ -342,7 +368,7 @@ class ImplicitMPM:
         narrow phase (Gamma_c, eqs 21-24) runs on touching pairs only."""
         if len(self.bodies) < 2:
             return []
-        band = self.problem_kw.get("band") or 2 * self.h
+        band = self.band
         pairs = _cpp.candidate_pairs(self.body_boxes().reshape(len(self.bodies), 4), 0.5 * band)
         return [tuple(int(v) for v in p) for p in np.asarray(pairs).reshape(-1, 2)]
 

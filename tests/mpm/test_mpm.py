@@ -364,3 +364,21 @@ def test_binned_mean_is_the_pixel_mean():
     assert np.isclose(image[1, 1], 7.0)
     image, _ = binned_mean(x[:-1], v[:-1], 0.25)  # finer: some pixels empty
     assert np.isnan(image).any() and np.nanmax(image) <= 5.0
+
+
+def test_band_grows_when_the_contact_reaches_its_edge():
+    """A contact band too small for the contact zone (0.002 mm: on the MPM path the gaps are
+    measured from the step's start, the active points' up to ~0.003 mm here): the step is
+    done again with the band doubled until no active point lies near its edge. The platen
+    force then matches the run started with a wide band, and the self-checks say nothing of
+    the band (issue 29, item 4, on the multi-step path)."""
+    from dolfinx_forms.solvers.checks import contact_warnings
+
+    narrow, wide = disc_sim(steps=3, mu=0.0, band=0.002), disc_sim(steps=3, mu=0.0, band=1.6)
+    for _ in range(3):
+        rn, rw = narrow.step(), wide.step()
+    assert rn["band"] > 0.002 and rw["band"] == 1.6
+    assert not narrow.band_reached()
+    assert not any("band" in w for w in contact_warnings(narrow.problem))
+    fn, fw = rn["obstacles"]["platen_top"]["fy"], rw["obstacles"]["platen_top"]["fy"]
+    assert fn == pytest.approx(fw, rel=1e-3)
