@@ -115,7 +115,8 @@ def unheld_bodies(problem):
     rotation about its centre) span a 3-dimensional space; the free ones are the null space of
     the Gram matrix G_k = (J R_k)^T (J R_k) in the metric M_k = R_k^T R_k, i.e. the c with
     |J R_k c| <= RIGID_RTOL |J| |R_k c| (`free_rigid_modes`). J is the last tangent (Dirichlet
-    rows kept as identity rows, the contact tangent of the settled active set). A rank test,
+    rows kept as identity rows, scaled to |J| here: a motion that moves a held dof is held;
+    the contact tangent of the settled active set). A rank test,
     not a test of each mode alone: a body touching at one sliding point is free in x and in
     the rotation about that point, whichever of the singular system's solutions the linear
     solver returned. All bodies' motions are the columns of one sparse R and J R one product
@@ -154,11 +155,17 @@ def unheld_bodies(problem):
         comm=comm,
     )
     JR = J.matMult(R)
-    A = reduce_rfactors(comm, body_rfactors(*JR.getValuesCSR(), nb))
+    norm = J.norm(PETSc.NormType.INFINITY)
+    jp, jc, jv = JR.getValuesCSR()
+    # a Dirichlet row of J is an identity row: a motion that moves a held dof is held, at the
+    # scale of the stiffness (a stiff penalty's |J| would otherwise hide the identity rows)
+    held_row = np.zeros(len(jp) - 1, bool)
+    held_row[np.asarray(problem.bc_owned, dtype=np.int64)] = True
+    jv = np.where(np.repeat(held_row, np.diff(jp)), jv * norm, jv)
+    A = reduce_rfactors(comm, body_rfactors(jp, jc, jv, nb))
     B = reduce_rfactors(comm, body_rfactors(ptr, cols.ravel(), vals.reshape(-1, 3).ravel(), nb))
     JR.destroy()
     R.destroy()
-    norm = J.norm(PETSc.NormType.INFINITY)
     out = []
     for k, b in enumerate(bodies):
         names = free_rigid_modes(A[k], B[k], norm, centre[k])
