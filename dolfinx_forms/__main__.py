@@ -52,12 +52,13 @@ def main(argv=None):
     rank0 = MPI.COMM_WORLD.rank == 0
     try:
         if args.command == "check":
-            from dolfinx_forms.app.scene_spec import load
+            from dolfinx_forms.app.description import load
 
             spec = load(args.scene, args.set)
             if rank0:
+                obstacles = f"{len(spec['obstacles'])} obstacles, " if "obstacles" in spec else ""
                 print(
-                    f"{args.scene}: {spec['name']}, {len(spec['bodies'])} bodies, "
+                    f"{args.scene}: {spec['name']}, {len(spec['bodies'])} bodies, {obstacles}"
                     f"{len(spec['stages'])} stages, {len(spec['checks'])} checks: ok"
                 )
             return 0

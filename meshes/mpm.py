@@ -1,11 +1,7 @@
-"""Scenes of the implicit MPM: cut scenes of grid level sets on one uniform background grid.
-
-`grid_scene(comm, xlines, ylines, bodies, ...)` returns the `build_scene(levelsets)` callback of
-`dolfinx_forms.mpm.implicit.ImplicitMPM`: every step it makes the cut scene of the current level
-sets (each body's window is the whole grid: only its level set decides its active cells). Also the
-Brazilian-disc set-up (paper 5.3.1): a disc between two rigid half-plane platens, with the checks
-of its demo's options; the nine discs in four plates (5.2.1), with the D4 symmetry check of the
-answer (d4_symmetry_error).
+"""Scenes of the implicit MPM on one uniform background grid (`grid_scene`, `uniform_lines`:
+dolfinx_forms.mesh.grid_scene, re-exported here). The Brazilian-disc set-up (paper 5.3.1): a
+disc between two rigid half-plane platens, with the checks of its demo's options; the nine discs
+in four plates (5.2.1), with the D4 symmetry check of the answer (d4_symmetry_error).
 """
 
 from __future__ import annotations
@@ -15,36 +11,8 @@ import numpy as np
 import dolfinx_forms as df
 from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.geometry.obstacles import RigidObstacle
-
-from dolfinx_forms.mesh.cut_scene import CutBody, cut_scene, half_plane
-
-
-def uniform_lines(lo, hi, h):
-    """Uniform grid lines k h covering [lo, hi] (lo, hi rounded outwards to multiples of h)."""
-    k0, k1 = int(np.floor(lo / h + 1e-9)), int(np.ceil(hi / h - 1e-9))
-    return h * np.arange(k0, k1 + 1, dtype=float)
-
-
-def grid_scene(comm, xlines, ylines, bodies, pairs=(), boundary_markers=None, contact_box=None):
-    """build_scene(levelsets {tag: _cpp.LevelSet}, pairs=None, boxes=None) -> Scene for `bodies`
-    [(name, tag)] on the grid; pairs: body-body contact pairs (indices into bodies; the
-    simulation passes its broad phase's each step, else these); boxes: the simulation's contact
-    boxes with their ranks ({"boxes", "owners"}, dolfinx_forms.mesh.scene.contact_partitioner), else
-    contact_box; boundary_markers: as in
-    meshes.cut.cut_scene (default none); contact_box: the cells kept on rank 0 where contact is
-    computed ((2, 2) or (k, 2, 2); None: from the pairs; required with obstacles in parallel)."""
-    xlines, ylines = np.asarray(xlines, float), np.asarray(ylines, float)
-    window = np.array([[xlines[0], ylines[0]], [xlines[-1], ylines[-1]]])
-    h = float(max(np.diff(xlines).max(), np.diff(ylines).max()))
-    fixed = list(pairs)
-
-    def build(levelsets, pairs=None, boxes=None):
-        cbodies = [CutBody(name, tag, window, levelsets[tag]) for name, tag in bodies]
-        use = fixed if pairs is None else [tuple(p) for p in pairs]
-        box = contact_box if boxes is None else boxes
-        return cut_scene(comm, xlines, ylines, cbodies, boundary_markers or {}, use, h, box)
-
-    return build
+from dolfinx_forms.mesh.cut_scene import half_plane
+from dolfinx_forms.mesh.grid_scene import grid_scene, uniform_lines  # noqa: F401  (re-exported)
 
 
 def brazilian_disc(comm, R=10.0, h=0.2, step_displacement=0.02, steps=50, margin=None):

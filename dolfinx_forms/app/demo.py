@@ -56,7 +56,9 @@ class Run:
     records, reactions, contact points, curves of the default plot). A context manager: a
     ContactSolverError inside ends the run with one line and status 1 (module doc)."""
 
-    def __init__(self, name, params, *, discretization=None, comm=None, plot=True, prog=None):
+    def __init__(
+        self, name, params, *, discretization=None, comm=None, plot=True, prog=None, reraise=False
+    ):
         from mpi4py import MPI
 
         self.name = name  # metrics.json "benchmark"
@@ -78,6 +80,7 @@ class Run:
         self.curves = {}  # analytic curves of the default plot
         self.plot_kw = {}  # title, xlabel, ylabel of the default plot
         self.status = None  # the exit status, once the run ended
+        self.reraise = reraise  # one process: a ContactSolverError leaves the block (an API)
         self._plot = plot and self.rank0
         if self._plot:  # matplotlib's import and clean-up overlap the run
             from dolfinx_forms.io import output
@@ -100,6 +103,8 @@ class Run:
                 sys.stderr.write(f"{self.prog}: error on rank {self.comm.rank}: {error}\n")
                 sys.stderr.flush()
                 self.comm.Abort(1)
+            if self.reraise:
+                return False
             if self.rank0:
                 sys.stderr.write(f"{self.prog}: {error}\n")
             self.status = 1

@@ -157,6 +157,7 @@ class Steps:
         self.points_series, self.grid_series = {}, Series("levelsets")
         run.data["series"] = self.points_series  # {body name: Series} of the points (rank 0)
         self.checks = {}  # warning -> first step where it was seen
+        self.series = True  # False: no time series (no frames kept, none written)
         self._x0 = None
         # the single-step results (reaction, half-width, p(x) errors) mean nothing here: a
         # multi-step record has the keys its demo fills, not nulls
@@ -164,12 +165,13 @@ class Steps:
             for k in [k for k, v in run.metrics[block].items() if v is None]:
                 del run.metrics[block][k]
 
-    def step(self):
+    def step(self, advance=None):
+        """One step: sim.step(), or advance() (a step found otherwise, e.g. to a force)."""
         from dolfinx_forms.solvers.checks import contact_warnings
 
         k = len(self.records)
         try:
-            rec = self.sim.step()
+            rec = self.sim.step() if advance is None else advance()
         except (ContactSolverError, RuntimeError) as e:  # Newton, or the geometry of a step
             raise ContactSolverError(f"step {k + 1}: {e}") from e
         self.records.append(rec)
@@ -180,7 +182,8 @@ class Steps:
                 t: p.x - d for (t, p), d in zip(self.sim.points.items(), self.sim.first_step_du)
             }
         last = k + 1 == self.num_steps
-        if self.run.rank0 and ((k + 1) % self.series_every == 0 or last or k == 0):
+        frame = (k + 1) % self.series_every == 0 or last or k == 0
+        if self.series and self.run.rank0 and frame:
             add_frames(self.sim, self.points_series, self.grid_series, rec["step"], self._x0)
         return rec
 
@@ -225,8 +228,9 @@ class Steps:
         write_table(folder / "steps.csv", self.columns, self.rows)
         write_table(folder / "contacts.csv", CONTACT_COLUMNS, contacts)
         write_table(folder / "bodies.csv", BODY_COLUMNS, bodies)
-        for series in list(self.points_series.values()) + [self.grid_series]:
-            series.write(folder)
+        if self.series:
+            for series in list(self.points_series.values()) + [self.grid_series]:
+                series.write(folder)
 
     def outputs(self, plots=None):
         """The keywords of `Run.finish` for a multi-step result folder: no single-step

@@ -69,9 +69,66 @@ def check(spec):
                 )
 
 
-def overlap_point(sd_a, sd_b, box_a, box_b, h):
-    """A point inside both bodies deeper than 1e-3 h (they may touch), or None: sampled on a
-    SAMPLES x SAMPLES grid of their common bounding box (sd: signed distances, < 0 inside)."""
+def check_mpm(spec):
+    """SpecError for the first geometric fault of a validated multi-step description
+    (mpm_spec.py): a self-crossing polygon; a body off the grid or narrower than 4 cells; two
+    bodies, or a body and an obstacle, overlapping deeper than h/2 (the multi-step scenes start
+    with shallow overlaps on purpose: they close the contacts of the first step)."""
+    from dolfinx_forms.mesh.from_spec import shape_of
+
+    h = spec["grid"]["h"]
+    ext = np.asarray(spec["grid"]["extent"], float)[:, :2]
+    things = [("bodies", b) for b in spec["bodies"]] + [("obstacles", o) for o in spec["obstacles"]]
+    index = {"bodies": 0, "obstacles": 0}
+    found = []
+    for kind, b in things:
+        i = index[kind]
+        index[kind] += 1
+        key = f"{kind}[{i}]"
+        if b["shape"]["type"] == "polygon":
+            k = self_crossing(np.asarray(b["shape"]["points"], float)[:, :2])
+            if k is not None:
+                raise SpecError(
+                    f"{key}.shape.points",
+                    f"{b['name']!r}: the polygon crosses itself (edges {k[0]} and {k[1]})",
+                )
+        try:
+            sd, box = shape_of(b["shape"], ext + [[-h], [h]] if kind == "obstacles" else None)
+        except SpecError:  # a half-plane that misses the grid
+            raise SpecError(f"{key}.shape", f"{b['name']!r} does not meet the grid") from None
+        if kind == "bodies":
+            size = float(np.min(box[1] - box[0]))
+            if h > size / 4:
+                raise SpecError(
+                    "grid.h",
+                    f"must be at most a quarter of the smallest body's size: body {b['name']!r} "
+                    f"is {size:.4g} across, h = {h:g} (four cells across at least)",
+                )
+            tol = 1e-9 * float(np.max(ext[1] - ext[0]))
+            if np.any(box[0] < ext[0] + h - tol) or np.any(box[1] > ext[1] - h + tol):
+                raise SpecError(
+                    key,
+                    f"body {b['name']!r} ({box[0].tolist()} .. {box[1].tolist()}) is not inside "
+                    f"the grid's extent {ext[0].tolist()} .. {ext[1].tolist()} by one cell",
+                )
+        found.append((kind, b["name"], sd, box, key))
+    for i, (ka, na, sa, ba, _) in enumerate(found):
+        for kb, nb, sb, bb, key in found[i + 1 :]:
+            if ka == "obstacles" and kb == "obstacles":
+                continue  # rigid obstacles may overlap each other
+            x = overlap_point(sa, sb, ba, bb, h, depth=0.5 * h)
+            if x is not None:
+                raise SpecError(
+                    key,
+                    f"{na!r} and {nb!r} overlap deeper than h/2 = {0.5 * h:g} (at "
+                    f"({x[0]:.4g}, {x[1]:.4g})): start them touching or overlapping less",
+                )
+
+
+def overlap_point(sd_a, sd_b, box_a, box_b, h, depth=None):
+    """A point inside both bodies deeper than `depth` (default 1e-3 h: they may touch), or
+    None: sampled on a SAMPLES x SAMPLES grid of their common bounding box (sd: signed
+    distances, < 0 inside)."""
     lo, hi = np.maximum(box_a[0], box_b[0]), np.minimum(box_a[1], box_b[1])
     if np.any(hi <= lo):
         return None
@@ -80,7 +137,7 @@ def overlap_point(sd_a, sd_b, box_a, box_b, h):
     x = np.c_[X.ravel(), Y.ravel()]
     both = np.minimum(-np.asarray(sd_a(x)), -np.asarray(sd_b(x)))
     k = int(np.argmax(both))
-    return x[k] if both[k] > 1e-3 * h else None
+    return x[k] if both[k] > (1e-3 * h if depth is None else depth) else None
 
 
 def self_crossing(P):

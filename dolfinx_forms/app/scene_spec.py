@@ -9,7 +9,8 @@ an "expression" is a number or a string in x, y, z with + - * / **, pi and sqrt,
 tan, exp, log, abs):
 
   name ["scene"; the file's stem], description [""], extends [none] (a description this one
-      changes: its tables merged key by key, anything else replaced)
+      changes: its tables merged key by key, anything else replaced), method ["single-step";
+      "mpm": a multi-step scene of the implicit MPM, whose keys mpm_spec.py lists]
   [discretization]  kind = "cut" | "fitted", h (mesh size at the contact),
       cut:    extent (box of the background grid), fine [none: uniform grid] (box where the
               spacing is h, widened to the multiples of h), growth [1.2], h_far [no cap];
@@ -363,33 +364,38 @@ def _solver(t):
             "linear_solver", "auto", choices=["auto", "condensed", "factorised", "iterative"]
         ),
     )
+    s["petsc"] = petsc_table(t, s["linear_solver"])
+    s["newton"] = newton_table(t)
+    t.done()
+    return s
+
+
+def petsc_table(t, linear_solver):
+    """`t.petsc` {KEY = VALUE}: strings, checked as the demos' --petsc (cli.check_petsc)."""
     petsc = t.table("petsc", {})
-    s["petsc"] = {}
+    out = {}
     for k, v in petsc.data.items():
         if isinstance(v, (dict, list)):
             raise SpecError(petsc.path(k), f"must be a string or a number, got {v!r}")
-        s["petsc"][k] = str(v).lower() if isinstance(v, bool) else str(v)
-    if s["petsc"] or s["linear_solver"] == "condensed":  # checked as the demos' --petsc
+        out[k] = str(v).lower() if isinstance(v, bool) else str(v)
+    if out or linear_solver == "condensed":  # checked as the demos' --petsc
         from dolfinx_forms.app.cli import ITERATIVE_DEFAULTS, check_petsc
 
-        base = ITERATIVE_DEFAULTS if s["linear_solver"] == "iterative" else None
-        why = check_petsc(s["petsc"], base, s["linear_solver"])
+        base = ITERATIVE_DEFAULTS if linear_solver == "iterative" else None
+        why = check_petsc(out, base, linear_solver)
         if why is not None:
             raise SpecError(t.path("petsc"), why)
+    return out
+
+
+def newton_table(t):
+    """`t.newton` {rtol, ftol, atol, stol, max_iterations, max_cutbacks}: the given ones."""
     newton = t.table("newton", {})
-    s["newton"] = {
-        k: newton.number(k, None, lo=0, lo_open=True) for k in ("rtol", "ftol", "atol", "stol")
-    }
-    s["newton"].update(
-        {
-            k: newton.integer(k, None, lo=lo)
-            for k, lo in (("max_iterations", 1), ("max_cutbacks", 0))
-        }
-    )
-    s["newton"] = {k: v for k, v in s["newton"].items() if v is not None}
+    out = {k: newton.number(k, None, lo=0, lo_open=True) for k in ("rtol", "ftol", "atol", "stol")}
+    for k, lo in (("max_iterations", 1), ("max_cutbacks", 0)):
+        out[k] = newton.integer(k, None, lo=lo)
     newton.done()
-    t.done()
-    return s
+    return {k: v for k, v in out.items() if v is not None}
 
 
 def _shape(t, base_dir):
@@ -708,12 +714,11 @@ def validate(data, base_dir=None, default_name="scene"):
     """Check a description (a dict, as read from TOML) and return a new dict with every
     default filled in. Raises SpecError naming the first bad key."""
     top = _Table(copy.deepcopy(data), "")
-    # a file's name gives the default, made plain ("my scene.toml": "my_scene")
-    default_name = re.sub(r"[^A-Za-z0-9_.-]", "_", default_name)[:100].strip(".") or "scene"
-    name = top.string("name", default_name)
-    if not NAME.fullmatch(name) or name in (".", ".."):
+    name = plain_name(top, default_name)
+    if top.string("method", "single-step") != "single-step":
         raise SpecError(
-            "name", f"a plain file name (letters, digits, '-', '_', '.'; at most 100), got {name!r}"
+            "method", f"{top.raw('method')!r}: not a single-step description (the multi-step "
+            "ones are read by dolfinx_forms.app.description.load)"
         )
     spec = {"name": name, "description": top.string("description", "")}
     spec["discretization"] = _discretization(top.table("discretization"))
@@ -751,6 +756,18 @@ def validate(data, base_dir=None, default_name="scene"):
 
     scene_geometry.check(spec)  # polygons, overlaps, the grid's extent, h against the bodies
     return spec
+
+
+def plain_name(top, default_name):
+    """The description's `name`: a plain file name, the folder of its results (default: the
+    file's stem, made plain: "my scene.toml" gives "my_scene")."""
+    default_name = re.sub(r"[^A-Za-z0-9_.-]", "_", default_name)[:100].strip(".") or "scene"
+    name = top.string("name", default_name)
+    if not NAME.fullmatch(name) or name in (".", ".."):
+        raise SpecError(
+            "name", f"a plain file name (letters, digits, '-', '_', '.'; at most 100), got {name!r}"
+        )
+    return name
 
 
 # the discretization keys one kind reads and the other refuses
@@ -836,11 +853,17 @@ def _read(path, seen=()):
     return _merge(_read(base, (*seen, path.resolve())), data)
 
 
-def load(source, overrides=()):
-    """A checked description from a TOML file path or a dict (see the module docstring)."""
+def read(source, overrides=()):
+    """(data with the overrides applied, base folder, default name) of a TOML file path or a
+    dict, before any check of its keys."""
     if isinstance(source, dict):
-        return validate(apply_overrides(source, overrides))
+        return apply_overrides(source, overrides), None, "scene"
     path = Path(source)
-    return validate(
-        apply_overrides(_read(path), overrides), base_dir=path.parent, default_name=path.stem
-    )
+    return apply_overrides(_read(path), overrides), path.parent, path.stem
+
+
+def load(source, overrides=()):
+    """A checked single-step description from a TOML file path or a dict (module docstring;
+    description.load reads either kind)."""
+    data, base_dir, default_name = read(source, overrides)
+    return validate(data, base_dir=base_dir, default_name=default_name)

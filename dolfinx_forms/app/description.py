@@ -1,0 +1,13 @@
+"""A scene description of either kind, read and checked: single-step (scene_spec.py) or
+multi-step (`method = "mpm"`, mpm_spec.py)."""
+
+from dolfinx_forms.app import mpm_spec, scene_spec
+
+
+def load(source, overrides=()):
+    """The checked description (every default filled in) of a TOML file path or a dict, with
+    the overrides ("a.b[1].c=VALUE") applied. Raises SpecError naming the first bad key."""
+    data, base_dir, default_name = scene_spec.read(source, overrides)
+    kind = data.get("method", "single-step") if isinstance(data, dict) else None
+    validate = mpm_spec.validate if kind == "mpm" else scene_spec.validate
+    return validate(data, base_dir=base_dir, default_name=default_name)

@@ -1,0 +1,312 @@
+"""Multi-step scene descriptions (`method = "mpm"`): deformable level-set bodies carrying
+material points, rigid obstacles moved step by step or to a force, run by the implicit MPM
+(`dolfinx_forms.mpm.implicit.ImplicitMPM`, `mpm_runner.run`). Read and checked here, like the
+single-step descriptions (scene_spec.py, whose value rules, shapes, laws, `[solver.petsc]`,
+`[solver.newton]`, `[[checks]]`, `extends` and `--set` these share). Keys (defaults in brackets;
+lengths and forces in the scene's units, angles in degrees):
+
+  method = "mpm", name ["scene"; the file's stem], description [""]
+  [units]  length [""], force [""]: the labels of the plots ("mm", "N")
+  [grid]  extent = [[x_min, y_min], [x_max, y_max]] (rounded outwards to multiples of h), h
+      (the uniform background grid of the level sets and the cut cells)
+  [solver]  mu [0], eps0 [1.0] (eq 51 penalty; the multi-step path is penalty only), band
+      [2 h; doubled while active points reach its edge], ghost_penalty [0.01], grid_refine
+      [4], num_gauss [2], linear_solver ["auto"], petsc {KEY = VALUE}, newton {rtol, ftol,
+      atol, stol, max_iterations, max_cutbacks}, predictor_gap [0], reinit_drift [0.2]
+  [[bodies]]  name, shape (circle, ellipse, box, polygon: as scene_spec), law = {type =
+      "linear", E, nu} | {type = "orthotropic", ...} (small strain per step: linear laws)
+  [[obstacles]]  name, shape (any shape of scene_spec, half_plane included: normal outward
+      from the obstacle), centre [the shape's centre; a half-plane's point; a polygon's
+      vertex mean] (the point it turns about and its moment is taken about), bodies [every
+      body] (the bodies it may touch)
+  [[dirichlet]]  name, box = {x_min, x_max, y_min, y_max} (the grid nodes inside, of any
+      body), component ["all" | "x" | "y"], value [0] (the prescribed increment per step)
+  [[stages]]  label [stage-i], steps, move = {obstacle = {translation = [dx, dy] per step,
+      rotation [0] degrees per step, counter-clockwise about its current centre}} (obstacles
+      not named stand still), dirichlet = {name = increment per step} [each its value],
+      target = {obstacle, component = "x" | "y", force (the obstacle's force at the stage's
+      end, reached linearly over its steps), tol [1e-3, relative to |force|], max_iter [12]}
+      (the obstacle's step translation along the component is found by secant iterations, each
+      a full step from the same state; its `move` translation is the first guess)
+  [outputs]  series [true], series_every [10], plots [true]
+  [analytic]  type = "hertz": body (a circle), obstacle (a half-plane): the contact
+      half-width against a = 2 sqrt(F R (1 - nu^2) / (pi E)) at every step with a > 5 h
+  [[checks]]  as scene_spec; quantities under results: steps, equilibrium_rel_max,
+      area_vs_points_rel_max, mass_rel_change_max, newton_iterations_mean, contacts_final,
+      obstacle_forces.<name> = [fx, fy, moment] (last step), band_final, and with [analytic]
+      half_width_rel_error_max, steps_judged
+"""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+
+from dolfinx_forms.app.scene_spec import (
+    SpecError,
+    _check,
+    _Table,
+    _component,
+    _law,
+    _name,
+    _shape,
+    newton_table,
+    petsc_table,
+    plain_name,
+)
+
+MAX_GRID_CELLS = 16_000_000  # 4000 x 4000
+MPM_LAWS = ("linear", "orthotropic")
+MAX_STEPS = 100_000
+
+
+def _grid(t):
+    from dolfinx_forms.mesh.grid_scene import uniform_lines
+
+    g = {"extent": t.box("extent"), "h": t.number("h", lo=0, lo_open=True)}
+    t.done()
+    (x0, y0), (x1, y1) = (p[:2] for p in g["extent"])
+    cells = (x1 - x0) / g["h"] * (y1 - y0) / g["h"]
+    if not cells <= MAX_GRID_CELLS:
+        raise SpecError(
+            "grid.h",
+            f"gives {cells:.3g} grid cells over the extent (at most {MAX_GRID_CELLS:.3g}), "
+            f"got h = {g['h']:g}",
+        )
+    g["xlines"] = uniform_lines(x0, x1, g["h"]).tolist()
+    g["ylines"] = uniform_lines(y0, y1, g["h"]).tolist()
+    return g
+
+
+def _solver(t):
+    enforcement = t.string("enforcement", "penalty", choices=["penalty", "augmented"])
+    if enforcement != "penalty":
+        raise SpecError(
+            "solver.enforcement",
+            "the multi-step path supports 'penalty' only (its friction transfer carries "
+            "point-wise slip from step to step)",
+        )
+    s = dict(
+        enforcement="penalty",
+        mu=t.number("mu", 0.0, lo=0),
+        eps0=t.number("eps0", 1.0, lo=0, lo_open=True),
+        band=t.number("band", None, lo=0, lo_open=True),
+        ghost_penalty=t.number("ghost_penalty", 0.01, lo=0),
+        grid_refine=t.integer("grid_refine", 4, lo=1, hi=16),
+        num_gauss=t.integer("num_gauss", 2, lo=1, hi=5),
+        predictor_gap=t.number("predictor_gap", 0.0, lo=0),
+        reinit_drift=t.number("reinit_drift", 0.2, lo=0, lo_open=True),
+        linear_solver=t.string(
+            "linear_solver", "auto", choices=["auto", "condensed", "factorised", "iterative"]
+        ),
+    )
+    s["petsc"] = petsc_table(t, s["linear_solver"])
+    s["newton"] = newton_table(t)
+    t.done()
+    return s
+
+
+def _centre(shape):
+    """The default centre of an obstacle: the point its rotation turns about."""
+    kind = shape["type"]
+    if kind in ("circle", "ellipse"):
+        return list(shape["centre"][:2])
+    if kind == "box":
+        return [0.5 * (a + b) for a, b in zip(shape["min"][:2], shape["max"][:2])]
+    if kind == "polygon":
+        return np.mean(np.asarray(shape["points"], float)[:, :2], axis=0).tolist()
+    return list(shape["point"][:2])
+
+
+def _bodies(top, base_dir):
+    bodies = {}
+    for b in top.tables("bodies"):
+        name = b.string("name")
+        if name in bodies:
+            raise SpecError(b.path("name"), f"duplicate body name {name!r}")
+        shape = _shape(b.table("shape"), base_dir)
+        if shape["type"] == "half_plane":
+            raise SpecError(
+                b.path("shape.type"), "a deformable body must be bounded (a half-plane can be "
+                "a rigid obstacle: [[obstacles]])"
+            )
+        law = _law(b.table("law"))
+        if law["type"] not in MPM_LAWS:
+            raise SpecError(
+                b.path("law.type"),
+                f"the multi-step path takes linear laws ({', '.join(MPM_LAWS)}): its stress "
+                f"update is C : d_eps per step, got {law['type']!r}",
+            )
+        bodies[name] = {"name": name, "shape": shape, "law": law}
+        b.done()
+    if not bodies:
+        raise SpecError("bodies", "missing (at least one [[bodies]] table)")
+    return list(bodies.values())
+
+
+def _obstacles(top, base_dir, body_names):
+    out = {}
+    for o in top.tables("obstacles"):
+        name = o.string("name")
+        if name in out or name in body_names:
+            raise SpecError(o.path("name"), f"duplicate name {name!r} (bodies and obstacles)")
+        shape = _shape(o.table("shape"), base_dir)
+        touch = o.raw("bodies", None)
+        if touch is not None and (
+            not isinstance(touch, list) or not touch or any(n not in body_names for n in touch)
+        ):
+            raise SpecError(o.path("bodies"), f"must be a list of body names, got {touch!r}")
+        out[name] = {
+            "name": name,
+            "shape": shape,
+            "centre": o.point("centre", None) or _centre(shape),
+            "bodies": touch,
+        }
+        o.done()
+    return list(out.values())
+
+
+def _dirichlet(top, grid):
+    out = {}
+    X, Y = np.meshgrid(grid["xlines"], grid["ylines"])
+    for t in top.tables("dirichlet"):
+        box = t.table("box")
+        b = {k: box.number(k, None) for k in ("x_min", "x_max", "y_min", "y_max")}
+        box.done()
+        d = {"box": b, "component": _component(t, "component", "all")}
+        if d["component"] == "z":
+            raise SpecError(t.path("component"), "must be 'x', 'y' or 'all' (scenes are 2D)")
+        d["value"] = t.number("value", 0.0)
+        d["name"] = t.string("name", f"dirichlet-{len(out) + 1}")
+        if d["name"] in out:
+            raise SpecError(t.path("name"), f"duplicate name {d['name']!r}")
+        if not np.any(box_mask(b, X.ravel(), Y.ravel())):
+            raise SpecError(t.path("box"), f"holds no node of the grid ({b})")
+        out[d["name"]] = d
+        t.done()
+    return out
+
+
+def box_mask(b, x, y):
+    """The points (x, y) inside the box {x_min, x_max, y_min, y_max} (None: unbounded)."""
+    m = np.ones(np.shape(x), bool)
+    for v, lo, hi in ((x, b["x_min"], b["x_max"]), (y, b["y_min"], b["y_max"])):
+        if lo is not None:
+            m &= v >= lo
+        if hi is not None:
+            m &= v <= hi
+    return m
+
+
+def _stage(t, i, obstacles, dirichlet, h):
+    st = {"label": t.string("label", f"stage-{i}"), "steps": t.integer("steps", lo=1, hi=MAX_STEPS)}
+    move = t.table("move", {})
+    st["move"] = {}
+    for name in list(move.data):
+        if name not in obstacles:
+            raise SpecError(move.path(name), f"unknown obstacle (known: {', '.join(obstacles)})")
+        m = move.table(name)
+        tr = m.point("translation", [0.0, 0.0])
+        if len(tr) != 2:
+            raise SpecError(m.path("translation"), "must be [dx, dy]")
+        st["move"][name] = {"translation": tr, "rotation": m.number("rotation", 0.0)}
+        m.done()
+    move.done()
+    inc = t.table("dirichlet", {})
+    st["dirichlet"] = {n: d["value"] for n, d in dirichlet.items()}
+    for name in list(inc.data):
+        if name not in dirichlet:
+            known = ", ".join(dirichlet) or "none"
+            raise SpecError(inc.path(name), f"unknown Dirichlet condition (known: {known})")
+        st["dirichlet"][name] = inc.number(name)
+    inc.done()
+    tg = t.table("target", None)
+    st["target"] = None
+    if tg is not None:
+        ob = _name(tg, "obstacle", list(obstacles), "obstacle")
+        comp = _component(tg, "component", "all")
+        if comp not in ("x", "y"):
+            raise SpecError(tg.path("component"), f"must be 'x' or 'y', got {comp!r}")
+        st["target"] = dict(
+            obstacle=ob,
+            component=comp,
+            force=tg.number("force"),
+            tol=tg.number("tol", 1e-3, lo=0, lo_open=True, hi=0.5),
+            max_iter=tg.integer("max_iter", 12, lo=2, hi=100),
+        )
+        guess = st["move"].get(ob, {"translation": [0.0, 0.0]})["translation"]["xy".index(comp)]
+        if guess == 0:
+            raise SpecError(
+                t.path("move"),
+                f"{ob!r} needs a nonzero translation along {comp} (the force target's first "
+                "guess of its step motion)",
+            )
+    for name, m in st["move"].items():  # the band and the level-set advection follow h / 2
+        travel = float(np.hypot(*m["translation"]))
+        if travel > 0.5 * h:
+            raise SpecError(
+                f"{t.path('move')}.{name}.translation",
+                f"must be at most h/2 = {0.5 * h:g} per step, got {travel:g}",
+            )
+    for name, v in st["dirichlet"].items():
+        if abs(v) > 0.5 * h:
+            raise SpecError(
+                t.path("dirichlet"), f"{name!r}: at most h/2 = {0.5 * h:g} per step, got {v:g}"
+            )
+    t.done()
+    return st
+
+
+def _analytic(t, bodies, obstacles):
+    kind = t.string("type", choices=("hertz",))
+    body = _name(t, "body", [b["name"] for b in bodies], "body")
+    ob = _name(t, "obstacle", [o["name"] for o in obstacles], "obstacle")
+    b = next(x for x in bodies if x["name"] == body)
+    if b["shape"]["type"] != "circle" or b["law"]["type"] != "linear":
+        raise SpecError(t.path("body"), "the hertz reference needs a circle with a linear law")
+    if next(o for o in obstacles if o["name"] == ob)["shape"]["type"] != "half_plane":
+        raise SpecError(t.path("obstacle"), "the hertz reference needs a half-plane obstacle")
+    t.done()
+    return {"type": kind, "body": body, "obstacle": ob, "R": b["shape"]["radius"]}
+
+
+def validate(data, base_dir=None, default_name="scene"):
+    """Check a multi-step description (a dict, as read from TOML) and return a new dict with
+    every default filled in. Raises SpecError naming the first bad key."""
+    top = _Table(copy.deepcopy(data), "")
+    name = plain_name(top, default_name)
+    top.string("method", choices=("mpm",))
+    spec = {"method": "mpm", "name": name, "description": top.string("description", "")}
+    units = top.table("units", {})
+    spec["units"] = {k: units.string(k, "") for k in ("length", "force")}
+    units.done()
+    spec["grid"] = grid = _grid(top.table("grid"))
+    spec["solver"] = _solver(top.table("solver", {}))
+    spec["bodies"] = _bodies(top, base_dir)
+    names = [b["name"] for b in spec["bodies"]]
+    spec["obstacles"] = _obstacles(top, base_dir, names)
+    dirichlet = _dirichlet(top, grid)
+    spec["dirichlet"] = list(dirichlet.values())
+    obstacles = {o["name"]: o for o in spec["obstacles"]}
+    stages = top.tables("stages")
+    if not stages:
+        raise SpecError("stages", "missing (at least one [[stages]] table with its steps)")
+    spec["stages"] = [
+        _stage(s, i, obstacles, dirichlet, grid["h"]) for i, s in enumerate(stages, start=1)
+    ]
+    out = top.table("outputs", {})
+    spec["outputs"] = dict(
+        series=out.boolean("series", True),
+        series_every=out.integer("series_every", 10, lo=1, hi=MAX_STEPS),
+        plots=out.boolean("plots", True),
+    )
+    out.done()
+    an = top.table("analytic", None)
+    spec["analytic"] = None if an is None else _analytic(an, spec["bodies"], spec["obstacles"])
+    spec["checks"] = [_check(c) for c in top.tables("checks")]
+    top.done()
+    from dolfinx_forms.app import scene_geometry
+
+    scene_geometry.check_mpm(spec)
+    return spec
