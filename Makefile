@@ -14,6 +14,10 @@ APT_PACKAGES := cmake make gcc g++ python3-sympy python3-dolfinx libdolfinx-dev 
 	python3-venv openmpi-bin libnanoflann-dev libopenblas0-pthread python3-h5py
 # only `make bench` installs these: benchmarks/work_precision.py compares with GetFEM's nodal P1
 BENCH_PACKAGES := python3-getfem
+# only `make test` installs these: tests/io/test_paraview.py opens the outputs in ParaView 5.11
+# (pvpython and paraview.simple; python3-paraview pulls in paraview) offscreen under xvfb-run
+# (Debian's ParaView renders through GLX only; xauth, which xvfb-run needs, is a Recommends)
+TEST_PACKAGES := python3-paraview xvfb xauth
 export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1
@@ -22,7 +26,8 @@ export PYTHONPATH := $(CURDIR)$(if $(PYTHONPATH),:$(PYTHONPATH))
 MPIRUN  ?= mpirun -n 2
 SUDO    := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: deps bench-deps build warm test test-cpp test-python test-mpi demo bench calibrate format clean
+.PHONY: deps bench-deps test-deps build warm test test-cpp test-python test-mpi demo bench calibrate \
+	format clean
 
 # $(call apt_install,PACKAGES): install those of PACKAGES that are missing
 define apt_install
@@ -41,12 +46,16 @@ deps:
 bench-deps:
 	$(call apt_install,$(BENCH_PACKAGES))
 
+# after deps: two apt-get runs at once (make -j) would fight over dpkg's lock
+test-deps: deps
+	$(call apt_install,$(TEST_PACKAGES))
+
 build: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=$(PYTHON) \
 	  -DCONTACT_BUILD_TESTS=ON -DCONTACT_BUILD_BENCHMARKS=ON
 	cmake --build $(BUILD) -j $(JOBS)
 
-test: build
+test: build test-deps
 	$(MAKE) --no-print-directory test-cpp test-python test-mpi
 
 test-cpp:
