@@ -10,10 +10,11 @@ there, points, cells, connectivity, ranges and values are what h5py and meshio r
 same files, the series show their last frame, and no PNG is blank (issue 29, item 5).
 
 ParaView reads an HDF5 array as its XDMF DataItem declares it; a DataItem without Precision is
-4-byte (the XDMF default). The series declare Precision="8"; solution.xdmf keeps DOLFINx 0.5's
-DataItems, which declare none, so ParaView holds its float64 arrays in single precision. Values
-are compared at the declared precision (rel 1e-12 after rounding h5py's array to it);
-test_float_arrays_declare_double_precision marks that gap (xfail, strict).
+4-byte (the XDMF default). DOLFINx 0.5 declares none for its float64 arrays (ParaView read them
+in single precision; with Precision but no NumberType they still did): output.one_grid adds
+NumberType="Float" Precision="8", and the series declare both
+(test_float_arrays_declare_double_precision). Values are compared at the declared precision
+(rel 1e-12 after rounding h5py's array to it).
 
 Skipped only when pvpython is absent; `make test` installs it (python3-paraview, xvfb, xauth).
 """
@@ -306,9 +307,6 @@ def test_png_is_not_blank(paraview, key):
     assert drawn.std(axis=0).max() > 20
 
 
-@pytest.mark.xfail(strict=True, reason="solution.xdmf keeps DOLFINx 0.5's float DataItems "
-                   "without Precision=\"8\": ParaView reads them as 4-byte floats "
-                   "(dolfinx_forms/io/output.py one_grid could add it)")
 def test_float_arrays_declare_double_precision(outputs):
     for key, (folder, name, _) in FILES.items():
         root = ET.parse(outputs[folder] / name).getroot()
