@@ -24,8 +24,9 @@ lengths and forces in the scene's units, angles in degrees):
   [[stages]]  label [stage-i], steps, move = {obstacle = {translation = [dx, dy] per step,
       rotation [0] degrees per step, counter-clockwise about its current centre}} (obstacles
       not named stand still), dirichlet = {name = increment per step} [each its value],
-      target = {obstacle, component = "x" | "y", force (the obstacle's force at the stage's
-      end, reached linearly over its steps), tol [1e-3, relative to |force|], max_iter [12]}
+      target = {obstacle, component = "x" | "y", force (the bodies' force on the obstacle at
+      the stage's end, reached linearly over its steps), tol [1e-3, relative to |force|],
+      max_iter [12]}
       (the obstacle's step translation along the component is found by secant iterations, each
       a full step from the same state; its `move` translation is the first guess)
   [outputs]  series [true], series_every [10], plots [true]

@@ -1,0 +1,154 @@
+"""Multi-step scenes from a description (`method = "mpm"`, app/mpm_spec.py, app/mpm_runner.py).
+
+The four MPM demos' scene files (demos/scenes/) give the demos' own contact and body records
+at coarse settings: the same level sets, points, obstacles and conditions built from the
+description instead of the demo's code (byte for byte where the geometry is the same; the grain
+assembly's rigid plates get other bounding boxes, which move the pair grids by round-off). A
+force target is reached within its tolerance; bad descriptions are one line, exit 2, nothing
+written. The tutorial's multi-step scene on 1 and 2 ranks: tests/app/test_tutorial.py."""
+
+import csv
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from dolfinx_forms.app.description import load
+from dolfinx_forms.common import SpecError
+
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+SCENES = ROOT / "demos" / "scenes"
+ENV = dict(os.environ, PYTHONPATH=str(ROOT), OPENBLAS_NUM_THREADS="1")
+
+
+def run(args, cwd, timeout=600):
+    return subprocess.run([sys.executable, *map(str, args)], capture_output=True, text=True,
+                          env=ENV, cwd=cwd, timeout=timeout)  # fmt: skip
+
+
+def table(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def assert_same_records(a, b, rtol):
+    """contacts.csv / bodies.csv of two runs: the same rows; numbers equal to rtol of their
+    column's largest magnitude, a body's resultant (zero: equilibrium) to rtol of the largest
+    contact force."""
+    force = max(abs(float(r["normal_force"])) for r in table(a / "contacts.csv"))
+    for name in ("contacts.csv", "bodies.csv"):
+        ra, rb = table(a / name), table(b / name)
+        assert len(ra) == len(rb) > 0, name
+        for key in ra[0]:
+            try:
+                x = np.array([float(r[key]) for r in ra])
+            except ValueError:
+                assert [r[key] for r in ra] == [r[key] for r in rb], (name, key)
+                continue
+            y = np.array([float(r[key]) for r in rb])
+            scale = max(np.abs(x).max(), force if key in ("fx", "fy", "moment") else 1e-300)
+            assert np.all(np.abs(x - y) <= rtol * scale), (name, key, np.abs(x - y).max() / scale)
+
+
+# the demo's command line, the scene's overrides giving the same run, the tolerance
+CASES = {
+    "brazilian_disc": (["--steps", "3", "--h", "0.5"],
+                       ["stages[0].steps=3", "grid.h=0.5", "checks=[]"], 0.0),
+    "nine_discs": ([], [], 0.0),
+    "four_grains": ([], [], 0.0),
+    "grain_assembly": (["--steps", "2", "--shear-steps", "1"],
+                       ["stages[0].steps=2", "stages[1].steps=1"], 1e-9),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_scene_file_gives_the_demo(tmp_path, name):
+    demo_args, overrides, rtol = CASES[name]
+    r = run([ROOT / "demos" / f"{name}.py", *demo_args, "--out", tmp_path / "demo"], tmp_path)
+    assert r.returncode == 0, r.stderr[-2000:]
+    sets = [a for o in overrides for a in ("--set", o)]
+    scene = SCENES / f"{name}.toml"
+    r = run(["-m", "dolfinx_forms", "run", scene, *sets, "--out", tmp_path / "scene"], tmp_path)
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    assert_same_records(tmp_path / "demo", tmp_path / "scene", rtol)
+    files = {p.name for p in (tmp_path / "scene").iterdir()}
+    assert {"steps.csv", "contacts.csv", "bodies.csv", "metrics.json", "levelsets.xdmf",
+            "force_chains.png"} <= files  # fmt: skip
+
+
+def test_force_target_is_reached(tmp_path):
+    """The upper platen of the Brazilian disc driven to a force of 400 in two steps: each
+    step's force within the target's tolerance of its share (200, then 400)."""
+    sets = ["stages[0].steps=2", "grid.h=0.5", "stages[0].target={obstacle='platen_top', "
+            "component='y', force=400.0, tol=1e-4}", "checks=[]"]  # fmt: skip
+    args = [a for s in sets for a in ("--set", s)]
+    out = tmp_path / "out"
+    r = run(["-m", "dolfinx_forms", "run", SCENES / "brazilian_disc.toml", *args, "--out", out],
+            tmp_path)  # fmt: skip
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    fy = [float(row["platen_top_fy"]) for row in table(out / "steps.csv")]
+    assert fy == pytest.approx([200.0, 400.0], abs=1e-4 * 400.0)
+
+
+BASE = {
+    "method": "mpm",
+    "grid": {"extent": [[-2.0, -2.0], [2.0, 2.0]], "h": 0.1},
+    "bodies": [{"name": "disc", "shape": {"type": "circle", "centre": [0.0, 0.0], "radius": 1.0},
+                "law": {"type": "linear", "E": 100.0, "nu": 0.3}}],
+    "obstacles": [{"name": "floor", "shape": {"type": "half_plane", "point": [0.0, -0.99],
+                   "normal": [0.0, 1.0]}}],
+    "stages": [{"steps": 2, "move": {"floor": {"translation": [0.0, 0.01]}}}],
+}  # fmt: skip
+
+BAD = [  # (override, the key the message names, a word of the message)
+    ("bodies[0].law={type='neo-hookean', E=1.0, nu=0.3}", "bodies[0].law.type", "linear"),
+    ("bodies[0].shape={type='half_plane', point=[0.0, 0.0], normal=[0.0, 1.0]}",
+     "bodies[0].shape.type", "bounded"),
+    ("solver.enforcement='augmented'", "solver.enforcement", "penalty"),
+    ("obstacles[0].shape.point=[0.0, -0.5]", "obstacles[0]", "deeper than h/2"),
+    ("bodies[0].shape.centre=[1.5, 0.0]", "bodies[0]", "not inside the grid"),
+    ("grid.h=0.6", "grid.h", "quarter"),
+    ("grid.h=1e-4", "grid.h", "grid cells"),
+    ("stages[0].move.floor.translation=[0.0, 0.2]", "stages[0].move.floor.translation", "h/2"),
+    ("stages[0].move.wall={translation=[0.0, 0.01]}", "stages[0].move.wall", "unknown obstacle"),
+    ("stages[0].target={obstacle='floor', component='x', force=1.0}", "stages[0].move",
+     "nonzero translation"),
+    ("stages[0].steps=0", "stages[0].steps", ">= 1"),
+    ("stages=[]", "stages", "missing"),
+    ("dirichlet=[{box={x_min=5.0}, component='x'}]", "dirichlet[0].box", "no node"),
+    ("obstacles[0].name='disc'", "obstacles[0].name", "duplicate"),
+    ("obstacles[0].bodies=['nobody']", "obstacles[0].bodies", "body names"),
+    ("analytic={type='hertz', body='disc', obstacle='floor', R=1.0}", "analytic.R", "unknown"),
+    ("solver.petsc={ksp_type='bogus'}", "solver.petsc", "bogus"),
+    ("outputs.series_every=0", "outputs.series_every", ">= 1"),
+    ("method='multi'", "method", "mpm"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("override,key,word", BAD)
+def test_bad_description_names_the_key(override, key, word):
+    with pytest.raises(SpecError) as e:
+        load(BASE, [override])
+    assert e.value.key == key, str(e.value)
+    assert word in str(e.value)
+
+
+def test_base_description_is_valid():
+    spec = load(BASE)
+    assert spec["solver"]["band"] is None and spec["stages"][0]["move"]["floor"]["rotation"] == 0
+
+
+def test_bad_description_on_the_command_line(tmp_path):
+    """One line naming the key, exit 2, nothing written."""
+    out = tmp_path / "out"
+    bad = "stages[0].move.platen_top.translation=[0.0, -5.0]"
+    r = run(["-m", "dolfinx_forms", "run", SCENES / "brazilian_disc.toml", "--set", bad,
+             "--out", out], tmp_path)  # fmt: skip
+    assert r.returncode == 2
+    assert "stages[0].move.platen_top.translation" in r.stderr
+    assert len(r.stderr.strip().splitlines()) <= 2  # usage line + the message
+    assert "Traceback" not in r.stderr and not out.exists()
