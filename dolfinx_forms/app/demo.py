@@ -158,6 +158,7 @@ class Run:
         """After the stages: the reactions at `reactions` (boundary names), the contact points
         (on rank 0), the mesh and solver blocks of metrics.json. Collective. Without a problem
         (a geometry demo) the mesh block is the demo's to fill."""
+        from dolfinx_forms.contact.resultants import contact_resultant
         from dolfinx_forms.io.output import gather_points
         from dolfinx_forms.solvers.problem import solver_metrics
 
@@ -174,6 +175,8 @@ class Run:
             num_dofs=problem.num_dofs,
         )
         self.metrics["solver"] = solver_metrics(problem)
+        # the contact force as a vector: the resultant of the tractions (collective)
+        self.results["contact_resultant"] = contact_resultant(problem)
 
     def close(self):
         """Stop the timer and give every rank rank 0's metrics (the evaluation is rank 0's)."""

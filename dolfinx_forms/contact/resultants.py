@@ -21,3 +21,17 @@ def traction_resultant(g, state, side="i", points=None, centre=None):
         return force, 0.0
     r = points - centre
     return force, float(np.sum(r[:, 0] * t[:, 1] - r[:, 1] * t[:, 0]))
+
+
+def contact_resultant(problem):
+    """[Fx, Fy]: the resultant of every pair's committed contact tractions on its second body
+    (body j, or the obstacle), summed over the pairs and the ranks: the contact force as a
+    vector (results.contact_force, sum w p_n, adds pressures along a curved zone)."""
+    from mpi4py import MPI
+
+    cs = problem.contact
+    f = np.zeros(2)
+    for g, s in zip(cs.pairs, cs.committed):
+        if s is not None and len(g.weights):
+            f += traction_resultant(g, s, "j")[0]
+    return problem.comm.allreduce(f, op=MPI.SUM).tolist()

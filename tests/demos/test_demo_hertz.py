@@ -98,6 +98,10 @@ def test_hertz_against_analytic(hertz):
     # equation, to Newton's tolerance), and the contact tractions carry it
     assert abs(res["reaction"][1] / m["parameters"]["load"] - 1) <= 1e-9
     assert abs(res["contact_force"] / res["reaction"][1] - 1) <= 2e-3
+    # the contact resultant (a vector) balances the support of the lower body: equilibrium, to
+    # the Newton tolerance (sum w p_n above adds pressures along the curved zone: 3e-4 high)
+    scale = abs(res["reaction"][1])
+    assert np.allclose(res["contact_resultant"], res["reaction"][:2], rtol=0, atol=1e-8 * scale)
     for k in ("total", "mesh", "assembly", "contact", "solve"):
         assert m["timing_s"][k] >= 0
     for f in ("tractions.csv", "tractions.png", "solution.xdmf", "solution.h5"):
