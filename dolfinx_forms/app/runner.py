@@ -229,6 +229,14 @@ REFERENCES = {"hertz": _hertz, "patch": _patch}
 
 
 # --------------------------------------------------------------------------- run
+def labels(spec):
+    """The traction plot's axis labels in the scene's [units] (none given: no unit)."""
+    u = spec["units"]
+    length = f" ({u['length']})" if u["length"] else ""
+    stress = f" ({u['force']}/{u['length']}^2)" if u["force"] and u["length"] else ""
+    return dict(xlabel=f"x{length}", ylabel=f"traction{stress}")
+
+
 def _reaction_boundaries(spec):
     names = [spec["outputs"]["reaction"]]
     ref = spec["analytic"] or {}
@@ -300,7 +308,7 @@ def run(
                 f"check {c['label']}: {'ok' if c['passed'] else 'FAILED'} "
                 f"({c['reason'] or c['criterion']})"
             )
-        r.plot_kw = dict(title=f"{spec['name']}, h = {r.scene.h_contact:.3g}")
+        r.plot_kw = dict(title=f"{spec['name']}, h = {r.scene.h_contact:.3g}", **labels(spec))
 
     r = compute(
         spec["name"],

@@ -11,6 +11,8 @@ tan, exp, log, abs):
   name ["scene"; the file's stem], description [""], extends [none] (a description this one
       changes: its tables merged key by key, anything else replaced), method ["single-step";
       "mpm": a multi-step scene of the implicit MPM, whose keys mpm_spec.py lists]
+  [units]  length [""], force [""]: the axis labels of the plots ("mm", "N": x (mm),
+      traction (N/mm^2)); the numbers are the user's, in any consistent units
   [discretization]  kind = "cut" | "fitted", h (mesh size at the contact),
       cut:    extent (box of the background grid), fine [none: uniform grid] (box where the
               spacing is h, widened to the multiples of h), growth [1.2], h_far [no cap];
@@ -721,6 +723,9 @@ def validate(data, base_dir=None, default_name="scene"):
             "ones are read by dolfinx_forms.app.description.load)"
         )
     spec = {"name": name, "description": top.string("description", "")}
+    units = top.table("units", {})
+    spec["units"] = {k: units.string(k, "") for k in ("length", "force")}
+    units.done()
     spec["discretization"] = _discretization(top.table("discretization"))
     spec["solver"] = _solver(top.table("solver", {}))
 

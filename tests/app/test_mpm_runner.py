@@ -152,3 +152,13 @@ def test_bad_description_on_the_command_line(tmp_path):
     assert "stages[0].move.platen_top.translation" in r.stderr
     assert len(r.stderr.strip().splitlines()) <= 2  # usage line + the message
     assert "Traceback" not in r.stderr and not out.exists()
+
+
+def test_plot_labels_from_the_scene_units():
+    """The traction plot's axes name the scene's [units], and nothing when it gives none."""
+    from dolfinx_forms.app.runner import labels
+
+    spec = load(SCENES / "hertz.toml")
+    assert labels(spec) == {"xlabel": "x (mm)", "ylabel": "traction (N/mm^2)"}
+    spec = load(SCENES / "patch.toml")
+    assert labels(spec) == {"xlabel": "x", "ylabel": "traction"}
