@@ -265,6 +265,13 @@ def run(
 
     spec = load(source, overrides)
     comm = MPI.COMM_WORLD if comm is None else comm
+    if comm.size > 1:  # ranks that read different files would take different paths and hang
+        import json
+
+        texts = comm.allgather(json.dumps(spec, sort_keys=True, default=str))
+        other = next((r for r, t in enumerate(texts) if t != texts[0]), None)
+        if other is not None:
+            raise SpecError(str(source), f"rank {other} read another description than rank 0")
     out = Path(out if out is not None else Path("results") / spec["name"])
     if write:
         check_output_path(out, force)

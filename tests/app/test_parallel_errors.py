@@ -134,3 +134,24 @@ def test_bad_argument_exit_2_on_every_rank(tmp_path):
     r, _ = mpirun([str(ROOT / "demos" / "patch_test.py"), "--out", str(foreign)], timeout=120)
     assert r.returncode == 2, r.stderr
     assert sorted(p.name for p in foreign.iterdir()) == ["keep.txt"]
+
+
+def test_ranks_that_read_different_descriptions_stop(tmp_path):
+    """The same command line, but each rank's folder holds another scene.toml (MPMD launch with
+    one working folder per rank): every rank refuses (exit 2) within seconds, nothing written."""
+    exe = shutil.which("mpirun")
+    if exe is None or MPI.COMM_WORLD.size > 1:
+        pytest.skip("no mpirun, or already under mpirun (no nested launch)")
+    scene = (ROOT / "demos" / "scenes" / "brazilian_disc.toml").read_text()
+    out = tmp_path / "out"
+    app = [sys.executable, "-m", "dolfinx_forms", "run", "scene.toml", "--out", str(out)]
+    cmd = [exe]
+    for rank, E in enumerate(("100e3", "200e3")):
+        (d := tmp_path / f"rank{rank}").mkdir()
+        (d / "scene.toml").write_text(scene.replace("E = 100e3", f"E = {E}"))
+        cmd += ([":"] if rank else []) + ["-n", "1", "--wdir", str(d), *app]
+    env = dict(os.environ, **MPI_ENV, PYTHONPATH=str(ROOT))
+    r = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=120)
+    assert r.returncode == 2, r.stderr[-2000:]
+    assert "rank 1 read another description than rank 0" in r.stderr
+    assert not out.exists()
