@@ -44,7 +44,7 @@ OPTIONS = [  # option, kind, default[, help]
     ("--overlap", "(0, inf)", 1e-3, "initial overlap of touching bodies (mm)"),
     ("--steps", range(1, 1001), 1),
     ("--h", "(0, inf)", 0.1, "grid spacing (mm)"),
-    ("--eps0", "(0, inf)", 1.0),
+    ("--eps0", cli.MPM_EPS0_INTERVAL, 1.0, cli.MPM_EPS0_HELP),
 ]
 COLUMNS = ["step", "displacement", "force_left", "force_right", "force_bottom", "force_top",
            "active_contacts", "min_stick_fraction", "newton_iterations", "wall_s"]

@@ -45,7 +45,7 @@ OPTIONS = [  # option, kind, default[, help]
     ("--shear-rotation", "[0, 0.01]", 0.3 / 180, "rotation of the lateral plates per step (rad)"),
     ("--shear-steps", range(0, 1001), 30),
     ("--h", "(0, inf)", 0.5, "grid spacing (mm)"),
-    ("--eps0", "(0, inf)", 1.0),
+    ("--eps0", cli.MPM_EPS0_INTERVAL, 1.0, cli.MPM_EPS0_HELP),
 ]
 PLATES = ("plate_left", "plate_right", "plate_bottom", "plate_top")
 COLUMNS = ["step", "phase"] + [f"{p}_{c}" for p in PLATES for c in ("normal", "tangential")] + [

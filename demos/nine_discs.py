@@ -42,7 +42,7 @@ OPTIONS = [  # option, kind, default[, help]
     ("--overlap", "(0, inf)", 1e-3, "initial overlap of touching bodies (mm)"),
     ("--steps", range(1, 1001), 1),
     ("--h", "(0, inf)", 0.1, "grid spacing (mm); must divide 3 R + 1"),
-    ("--eps0", "(0, inf)", 1.0),
+    ("--eps0", cli.MPM_EPS0_INTERVAL, 1.0, cli.MPM_EPS0_HELP),
 ]
 COLUMNS = ["step", "displacement", "force_left", "force_right", "force_bottom", "force_top",
            "newton_iterations", "wall_s"]

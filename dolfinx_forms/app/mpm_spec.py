@@ -9,7 +9,7 @@ lengths and forces in the scene's units, angles in degrees):
   [units]  length [""], force [""]: the labels of the plots ("mm", "N")
   [grid]  extent = [[x_min, y_min], [x_max, y_max]] (rounded outwards to multiples of h), h
       (the uniform background grid of the level sets and the cut cells)
-  [solver]  mu [0], eps0 [1.0] (eq 51 penalty; the multi-step path is penalty only), band
+  [solver]  mu [0], eps0 [1.0] (eq 51 penalty, in [1e-4, 1]: cli.MPM_EPS0; penalty only), band
       [2 h; doubled while active points reach its edge], ghost_penalty [0.01], grid_refine
       [4], num_gauss [2], linear_solver ["auto"], petsc {KEY = VALUE}, newton {rtol, ftol,
       atol, stol, max_iterations, max_cutbacks}, predictor_gap [0], reinit_drift [0.2]
@@ -80,6 +80,21 @@ def _grid(t):
     return g
 
 
+def _eps0(t):
+    """solver.eps0 in the range the MPM demos' --eps0 accept (cli.MPM_EPS0: measured)."""
+    from dolfinx_forms.app.cli import MPM_EPS0, MPM_EPS0_INTERVAL
+
+    eps0 = t.number("eps0", 1.0, lo=0, lo_open=True)
+    if not MPM_EPS0[0] <= eps0 <= MPM_EPS0[1]:
+        raise SpecError(
+            t.path("eps0"),
+            f"must be in {MPM_EPS0_INTERVAL} on the multi-step path (above 1 the bodies pass "
+            f"through each other: forces 1e5x too small at 1e6; below 1e-4 Newton fails), "
+            f"got {eps0:g}",
+        )
+    return eps0
+
+
 def _solver(t):
     enforcement = t.string("enforcement", "penalty", choices=["penalty", "augmented"])
     if enforcement != "penalty":
@@ -91,7 +106,7 @@ def _solver(t):
     s = dict(
         enforcement="penalty",
         mu=t.number("mu", 0.0, lo=0),
-        eps0=t.number("eps0", 1.0, lo=0, lo_open=True),
+        eps0=_eps0(t),
         band=t.number("band", None, lo=0, lo_open=True),
         ghost_penalty=t.number("ghost_penalty", 0.01, lo=0),
         grid_refine=t.integer("grid_refine", 4, lo=1, hi=16),
