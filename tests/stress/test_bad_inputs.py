@@ -169,9 +169,18 @@ CASES = [
     ("brazilian_disc", "--linear-solver condensed --petsc ksp_type=cg", "--petsc"),
     ("four_grains", "--linear-solver condensed --petsc pc_type=lu", "--petsc"),
     ("nine_discs", "--linear-solver condensed --petsc ksp_type=cg", "--petsc"),
+    ("grain_assembly", "--linear-solver condensed --petsc ksp_type=cg", "--petsc"),
     # ------------------------------------------------ --out too long for the file system
     ("patch_test", "--out {d}/" + "a" * 300, "--out"),
     ("hertz", "--out {d}/" + "b" * 240, "--out"),
+    # issue 29: the other demos computed the whole run, then failed with a traceback
+    ("two_blocks", "--out {d}/" + "c" * 300, "--out"),
+    ("inclined_interface", "--out {d}/" + "d" * 300, "--out"),
+    ("brazilian_disc", "--out {d}/" + "e" * 300, "--out"),
+    ("nine_discs", "--out {d}/" + "f" * 300, "--out"),
+    ("four_grains", "--out {d}/" + "g" * 256, "--out"),
+    ("grain_assembly", "--out {d}/" + "h" * 300, "--out"),
+    ("contact_geometry", "--out {d}/" + "i" * 300, "--out"),
     # ------------------------------------------------ --out
     ("patch_test", "--out .", "--out"),
     ("hertz", "--out . --force", "--out"),

@@ -1,0 +1,51 @@
+"""Run many command lines of `python3 -m dolfinx_forms` in ONE interpreter (as cli_batch.py
+does for the demos): the imports cost ~2 s per process, a refused description milliseconds.
+
+    /usr/bin/python3 tests/stress/runner_batch.py CASES.json RESULTS.json
+
+CASES.json: a list of {"argv": [...], "cwd": "/some/folder"}; RESULTS.json: per case {"code",
+"status", "stdout", "stderr", "seconds"} with the statuses of cli_batch.py; "computed": the
+description passed every check and the multi-step run (`mpm_runner.run`) would have started
+(it is replaced by a function that raises).
+Nothing here is a pytest test; tests/stress/test_hostile_multistep.py starts it.
+"""
+
+import json
+import os
+import signal
+import sys
+import tempfile
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import cli_batch  # noqa: E402
+
+
+def main(cases_file, results_file):
+    import dolfinx_forms.__main__ as entry
+    from dolfinx_forms.app import mpm_runner
+
+    mpm_runner.run = cli_batch._guard  # a description that passed: stop before computing
+    cases = json.loads(Path(cases_file).read_text())
+
+    def alarm(signum, frame):
+        raise cli_batch.Timeout()
+
+    signal.signal(signal.SIGALRM, alarm)
+    home = os.getcwd()
+    scratch = tempfile.mkdtemp(prefix="runner_batch.")
+    results = []
+    try:
+        for case in cases:
+            results.append(cli_batch.run_one(entry, "-m dolfinx_forms", case, scratch))
+    finally:
+        os.chdir(home)
+        for p in Path(scratch).iterdir():
+            p.unlink()
+        os.rmdir(scratch)
+    Path(results_file).write_text(json.dumps(results, indent=1))
+
+
+if __name__ == "__main__":
+    main(*sys.argv[1:3])
