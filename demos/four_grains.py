@@ -37,7 +37,7 @@ from meshes.plots import four_grains_plots
 OPTIONS = [  # option, kind, default[, help]
     ("--radius", "(0, inf)", 2.0, "mean radius of the largest given grain size (mm)"),
     ("--seed", int, 1, "seed of the Fourier grain outline, in [0, 2^31)"),
-    ("--E", "(0, inf)", 10e3, "Young's modulus (N/mm^2)"),
+    ("--E", "[1e-3, 1e7]", 10e3, "Young's modulus (N/mm^2; verified 1e-3 to 1e7)"),
     ("--nu", "(-1, 0.5)", 0.3),
     ("--mu", "(0, inf)", 0.5, "friction coefficient (> 0: frictionless grains turn freely)"),
     ("--displacement", "(0, inf)", 1e-3, "inward motion of each plate per step (mm)"),

@@ -37,12 +37,12 @@ from meshes.plots import grain_assembly_plots
 OPTIONS = [  # option, kind, default[, help]
     ("--grains", range(2, 1001), 15),
     ("--radius", "(0, inf)", 5.0, "mean grain radius (mm)"),
-    ("--E", "(0, inf)", 100e3, "Young's modulus (N/mm^2)"),
+    ("--E", "[1e-3, 1e7]", 100e3, "Young's modulus (N/mm^2; verified 1e-3 to 1e7)"),
     ("--nu", "(-1, 0.5)", 0.2),
     ("--friction-angle", "(0, 60]", 15.0, "degrees (mu = tan of it)"),
     ("--compression", "(0, inf)", 0.01, "inward motion of each plate per step (mm)"),
     ("--steps", range(0, 1001), 30, "compression steps"),
-    ("--shear-rotation", "[0, 0.01]", 0.3 / 180, "rotation of the lateral plates per step (rad)"),
+    ("--shear-rotation", "(0, 0.5]", np.degrees(0.3 / 180), "lateral plates' turn per step (deg)"),
     ("--shear-steps", range(0, 1001), 30),
     ("--h", "(0, inf)", 0.5, "grid spacing (mm)"),
     ("--eps0", cli.MPM_EPS0_INTERVAL, 1.0, cli.MPM_EPS0_HELP),
@@ -128,7 +128,7 @@ def main(argv=None):
                 for name in PLATES:
                     plates[name].translation = np.zeros(2)
                 for name in ("plate_left", "plate_right"):
-                    plates[name].rotation = -args.shear_rotation
+                    plates[name].rotation = -np.radians(args.shear_rotation)
         steps.measure()
 
         # the check (rank 0)

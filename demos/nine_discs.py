@@ -35,7 +35,7 @@ from meshes.mpm import d4_symmetry_error, nine_discs, plate_face_conditions, pla
 # fmt: off
 OPTIONS = [  # option, kind, default[, help]
     ("--R", "(0, inf)", 1.7, "disc radius (mm)"),
-    ("--E", "(0, inf)", 100e3, "Young's modulus (N/mm^2)"),
+    ("--E", "[1e-3, 1e7]", 100e3, "Young's modulus (N/mm^2; verified 1e-3 to 1e7)"),
     ("--nu", "(-1, 0.5)", 0.3),
     ("--mu", "(0, inf)", 0.5, "friction coefficient (> 0: frictionless discs turn freely)"),
     ("--displacement", "(0, inf)", 1e-4, "inward motion of each plate per step (mm)"),

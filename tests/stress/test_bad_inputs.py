@@ -41,8 +41,11 @@ CASES = [
     ("two_blocks", "--h 2.6", "--h"),  # (0, 2.5]
     ("inclined_interface", "--h 251", "--h"),  # (0, 250]
     ("grain_assembly", "--friction-angle 61", "--friction-angle"),  # (0, 60]
-    ("grain_assembly", "--shear-rotation 0.02", "--shear-rotation"),  # [0, 0.01]
+    ("grain_assembly", "--shear-rotation 0.6", "--shear-rotation"),  # (0, 0.5] degrees
+    ("grain_assembly", "--shear-rotation 0", "--shear-rotation"),  # at the open end
     ("grain_assembly", "--shear-rotation -0.001", "--shear-rotation"),
+    ("brazilian_disc", "--E 1e-300", "--E"),  # [1e-3, 1e7]: 0 Newton iterations at 1e-300
+    ("nine_discs", "--E 1e12", "--E"),
     ("contact_geometry", "--gap -1", "--gap"),  # [0, inf)
     ("contact_geometry", "--eps 0", "--eps"),
     ("brazilian_disc", "--step-displacement 0", "--step-displacement"),
@@ -326,7 +329,7 @@ REAL = [
     "brazilian_disc.py --steps 10001",
     "nine_discs.py --petsc =1",
     "four_grains.py --E=-inf",
-    "grain_assembly.py --shear-rotation 0.02",
+    "grain_assembly.py --shear-rotation 0.6",
 ]
 
 
