@@ -139,6 +139,8 @@ def _bodies(top, base_dir):
     bodies = {}
     for b in top.tables("bodies"):
         name = b.string("name")
+        if not name.strip():
+            raise SpecError(b.path("name"), "must not be empty")
         if name in bodies:
             raise SpecError(b.path("name"), f"duplicate body name {name!r}")
         shape = _shape(b.table("shape"), base_dir)
@@ -165,6 +167,8 @@ def _obstacles(top, base_dir, body_names):
     out = {}
     for o in top.tables("obstacles"):
         name = o.string("name")
+        if not name.strip():
+            raise SpecError(o.path("name"), "must not be empty")
         if name in out or name in body_names:
             raise SpecError(o.path("name"), f"duplicate name {name!r} (bodies and obstacles)")
         shape = _shape(o.table("shape"), base_dir)

@@ -126,6 +126,8 @@ BAD = [  # (override, the key the message names, a word of the message)
     ("solver.petsc={ksp_type='bogus'}", "solver.petsc", "bogus"),
     ("outputs.series_every=0", "outputs.series_every", ">= 1"),
     ("method='multi'", "method", "mpm"),
+    ("bodies[0].name=''", "bodies[0].name", "empty"),
+    ("obstacles[0].name=' '", "obstacles[0].name", "empty"),
 ]  # fmt: skip
 
 
