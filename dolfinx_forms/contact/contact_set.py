@@ -82,7 +82,9 @@ class ContactSet(Multipliers):
     `obstacles.RigidObstacle`s, each paired with every body it may touch (its `bodies`); their
     prescribed motion at load level lam is set by `set_load`. eps_t_start (augmented, >= eps_t,
     default eps_t): the tangential regularisation each step's loop starts from, continued to
-    eps_t once it converges (`newton.augmented_loop`)."""
+    eps_t once it converges (`newton.augmented_loop`). origins: {candidate index (`index`):
+    the point its pair's level-set grid passes through} (a rebuild over a wider band keeps the
+    old grids' lattices, `contact.band`)."""
 
     def __init__(
         self,
@@ -104,6 +106,7 @@ class ContactSet(Multipliers):
         relaxation=1.0,
         multiplier_mass="lumped",
         eps_t_start=None,
+        origins=None,
     ):
         if enforcement not in ("penalty", "augmented"):
             raise ValueError(f"enforcement must be 'penalty' or 'augmented', got {enforcement!r}")
@@ -129,7 +132,7 @@ class ContactSet(Multipliers):
             traction=traction,
             multiplier_mass=multiplier_mass,
         )
-        self.pairs, self.index = build_pairs(V, scene, band, rank, self.obstacles, kw)
+        self.pairs, self.index = build_pairs(V, scene, band, rank, self.obstacles, kw, origins)
         self._lam = None
         # friction history, slip origin and multipliers live at the law points (the multiplier
         # nodes, or the points): `PairGeometry.num_law_points`
@@ -143,6 +146,9 @@ class ContactSet(Multipliers):
         # current ones and the committed tractions they start from
         self.lambda_n = [np.zeros(g.num_law_points) for g in self.pairs]
         self.lambda_t = [np.zeros(g.num_law_points) for g in self.pairs]
+        # where friction was switched on (displacement, load level; None: from the start, at
+        # u = 0): the slip origin of points a rebuild adds (`contact.band`)
+        self.friction_origin = None
 
     def __len__(self):
         return len(self.pairs)
@@ -271,6 +277,7 @@ class ContactSet(Multipliers):
         traction: the committed plastic slip is the current (law point) tangential gap."""
         mu = float(mu)
         if mu > 0 and self.mu == 0:
+            self.friction_origin = (np.array(u, dtype=float), self._lam)
             for k, h in enumerate(self.history):
                 g = self.pairs[k]
                 h.trial = self._evaluate(k, u, mu=0.0)["law_g_t"]
@@ -329,10 +336,11 @@ class ContactSet(Multipliers):
         return out
 
 
-def build_pairs(V, scene, band, rank, obstacles, kw):
+def build_pairs(V, scene, band, rank, obstacles, kw, origins=None):
     """The pair geometries this rank holds (`geometry.pairs.pair_geometry`) and, for each, its
     index among the candidates (scene.pairs, then each obstacle with each body it may touch).
-    rank: the rank that computes every pair, or {pair key: rank} (pair_key; others on 0)."""
+    rank: the rank that computes every pair, or {pair key: rank} (pair_key; others on 0).
+    origins: {candidate index: lattice origin of its pair grid} (others: kw's)."""
 
     def owner(key):
         return rank.get(key, 0) if isinstance(rank, dict) else rank
@@ -348,7 +356,8 @@ def build_pairs(V, scene, band, rank, obstacles, kw):
     for c, (pair, ob) in enumerate(candidates):
         if owner(pair_key(pair, ob)) != me:
             continue
-        g = pair_geometry(V, scene, pair, band, obstacle=ob, **kw)
+        at = {} if not origins or c not in origins else {"lattice_origin": origins[c]}
+        g = pair_geometry(V, scene, pair, band, obstacle=ob, **{**kw, **at})
         if g is not None:
             pairs.append(g)
             index.append(c)

@@ -236,7 +236,7 @@ class ImplicitMPM:
                     scale=lambda lam: 1.0,
                 )
             )
-        kw = dict(self.problem_kw, band=self.band)
+        kw = dict(self.problem_kw, band=self.band, band_growth=0)  # `step` grows it
         kw.setdefault("pair_grid_origin", (self.xlines[0], self.ylines[0]))
         if ranks is not None:
             kw["contact_rank"] = ranks

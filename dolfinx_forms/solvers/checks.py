@@ -6,7 +6,10 @@ them) and returns, on every rank, one line per failed check:
 * penetration: an active point's gap below -PENETRATION h (the penalty is too soft for the
   load: its answer then depends on eps0);
 * band: an active point whose initial gap is within 10 % of the contact band (Gamma_c covers
-  initial gaps up to the band only: the zone may be cut at its edge, give a larger band);
+  initial gaps up to the band only: the zone may be cut at its edge, give a larger band). The
+  single-step solver doubles the band and does the step again when that happens
+  (`ContactProblem.grow_band`), so this fires where the band may not grow (band_growth 0),
+  and its bound reached is an error (`band_errors`, first in the list);
 * checkerboard: two or more runs of open points between active ones along a pair's contact
   surface, each shorter than h (more point-wise constraints than the trace can follow: a
   stiff point-wise penalty; the augmented enforcement's segments do not do this). Separate
@@ -106,7 +109,9 @@ def contact_warnings(problem):
     for k, (g, s) in enumerate(zip(cs.pairs, cs.committed)):
         if s is not None:
             mine += pair_warnings(g, s, problem.scene.h_contact, problem.band, "-".join(names[k]))
-    return [w for part in problem.comm.allgather(mine) for w in part] + unheld_bodies(problem)
+    errors = list(getattr(problem, "band_errors", []))  # the band's growth bound reached
+    parts = problem.comm.allgather(mine)
+    return errors + [w for part in parts for w in part] + unheld_bodies(problem)
 
 
 def unheld_bodies(problem):

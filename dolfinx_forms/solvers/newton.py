@@ -3,7 +3,9 @@
 `newton` iterates at one load level from the committed state; `load_steps` ramps the load
 level in equal steps and halves a step that fails (no convergence in `max_iterations`, a
 repeated active set without residual decrease, a linear-solver failure, a non-finite residual),
-restoring u and the friction history exactly, at most `max_cutbacks` times.
+restoring u and the friction history exactly, at most `max_cutbacks` times. A converged step
+whose active contact points reach the edge of the contact band is done again from the
+committed state with the band doubled (`ContactProblem.grow_band`).
 """
 
 import time
@@ -326,6 +328,11 @@ def load_steps(problem, num_steps=1, lam_end=1.0, label="step", initial_guess=No
         augmentations = 0
         if ok and problem.contact.augmented:
             ok, augmentations, why = augmented_loop(problem, target, residuals)
+        # active points at the band's edge: the step again from the committed state, with
+        # the band doubled (no cut-back: the step converged)
+        if ok and getattr(problem, "band_growth", 0) and problem.band_reached():
+            if problem.grow_band(target):
+                continue
         if ok:
             problem.commit(target)
             problem.steps.append(

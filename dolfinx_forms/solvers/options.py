@@ -17,8 +17,11 @@ class ContactOptions:
     mu: Coulomb friction coefficient (0: frictionless, no friction work). eps0: the penalty
     factor of eq 51, eps_n = eps_t = eps0 h / E_c (`contact.penalty`); with "augmented" it sets
     only the Uzawa step. band: the largest initial gap that Gamma_c covers (a length; default
-    2 h). enforcement: "penalty" (the answer depends on eps0) or "augmented" (augmented
-    Lagrangian, Uzawa loop, `contact.contact_set`). multipliers: None (a traction per contact
+    2 h) at the start; band_growth: how often it may double (`ContactProblem.grow_band`: a
+    converged load step whose active points reach 0.9 band is done again with the band
+    doubled; 0: a fixed band, as the MPM steps, which grow their own). enforcement:
+    "penalty" (the answer depends on eps0) or "augmented" (augmented Lagrangian, Uzawa loop,
+    `contact.contact_set`). multipliers: None (a traction per contact
     point), "P0" or "P1" (one traction per node along Gamma_c, nodes multiplier_length apart);
     "default": "P1" with "augmented", None with "penalty". multiplier_length: default h
     body-fitted, 1.5 h cut (consistent_length h with the consistent or hybrid projection).
@@ -36,6 +39,7 @@ class ContactOptions:
     mu: float = 0.0
     eps0: float = 1.0
     band: float | None = None
+    band_growth: int = 4
     enforcement: str = "penalty"
     multipliers: str | None = "default"
     multiplier_length: float | None = None

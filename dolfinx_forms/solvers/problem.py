@@ -22,6 +22,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from dolfinx_forms import defaults
+from dolfinx_forms.contact.band import carry_state, lattice_origins
 from dolfinx_forms.contact.contact_set import ContactSet
 from dolfinx_forms.contact.penalty import contact_modulus, penalty_parameter
 from dolfinx_forms.fem.boundary import dirichlet_dofs
@@ -29,11 +30,15 @@ from dolfinx_forms.fem.bulk import BulkForms
 from dolfinx_forms.fem.laws import as_law
 from dolfinx_forms.geometry.pairs import DEFAULT_MULTIPLIER_MASS, MULTIPLIER_MASSES, TRACTIONS
 from dolfinx_forms.solvers import blas, linear
-from dolfinx_forms.solvers.newton import NewtonOptions, load_steps
+from dolfinx_forms.solvers.newton import ContactSolverError, NewtonOptions, load_steps
 from dolfinx_forms.solvers.options import ContactOptions, FemOptions, SolverOptions
 
 # the tuned factors of the augmented Lagrangian's regularisation and the BLAS threshold are
 # read from dolfinx_forms.defaults.TUNING when a problem is made (their studies: STUDIES there)
+
+# active points with an initial gap above this fraction of the band reach its edge: the band
+# doubles and the step is done again (`ContactProblem.grow_band`; `checks.pair_warnings`)
+BAND_EDGE = 0.9
 
 
 class ContactProblem:
@@ -79,11 +84,15 @@ class ContactProblem:
         with self.phase("assembly"):
             self._bulk(fo, dirichlet, tractions, loads)
         h = scene.h_contact
-        self.band = c.band if c.band is not None else 2 * h
+        self.band = self.band_start = float(c.band if c.band is not None else 2 * h)
+        self.band_growth = int(c.band_growth)  # doublings allowed (`grow_band`)
+        self.band_errors = []  # the growth bound reached: error-level warnings
         E_c = contact_modulus(scene, self.laws, obstacles)
         settings = enforcement(c, h, E_c, cut=self.integration is not None)
         self.eps_n, self.eps_t = settings["eps_n"], settings["eps_t"]
         self.multiplier_mass = settings["multiplier_mass"]
+        # what a rebuild over a wider band needs (`grow_band`)
+        self._rebuild = dict(settings=dict(settings, obstacles=obstacles), fem=fo, solver=so)
         with self.phase("contact"):
             self.contact = ContactSet(
                 self.V, scene, band=self.band, obstacles=obstacles, **settings
@@ -91,6 +100,7 @@ class ContactProblem:
         self.pairs = self.contact.pairs
         with self.phase("assembly"):
             self._matrices(fo.ghost_penalty)
+        self.retired = [0, 0]  # factorisations of the linear solvers a band growth replaced
         with self.phase("solve"):  # the condensed bulk is factorised here, once
             self.linear = linear.choose(self, so.linear_solver, so.petsc_options)
         self.control = None  # force_control.ForceControl while a force-controlled stage runs
@@ -172,8 +182,12 @@ class ContactProblem:
     # ------------------------------------------------------------------ utilities
     @property
     def factorisations(self):
-        """Sparse factorisations so far (the condensed bulk: one per scene)."""
-        return self.linear.factorisations
+        """Sparse factorisations so far (the condensed bulk: one per scene and band)."""
+        return self.retired[0] + self.linear.factorisations
+
+    @property
+    def schur_factorisations(self):
+        return self.retired[1] + int(getattr(self.linear, "schur_factorisations", 0))
 
     @property
     def mu(self):
@@ -261,6 +275,63 @@ class ContactProblem:
         cut-back (`newton.load_steps`). Raises ContactSolverError."""
         load_steps(self, num_steps, lam_end, label, initial_guess)
 
+    # ------------------------------------------------------------------ the band
+    def band_reached(self):
+        """Whether an active contact point of the last evaluation has an initial gap above
+        BAND_EDGE band: Gamma_c may cut the contact zone off there (the same on every rank)."""
+        near = any(
+            s is not None and bool(np.any((s["state"] > 0) & (g.g_n0 > BAND_EDGE * self.band)))
+            for g, s in zip(self.contact.pairs, self.contact.last)
+        )
+        return bool(self.comm.allreduce(near, op=MPI.LOR))
+
+    def grow_band(self, lam):
+        """After a converged step to load level lam whose active points reached the band's edge
+        (`band_reached`): back to the committed state, the band doubled, the pair geometry,
+        matrices and linear solver rebuilt, the committed state carried over
+        (`contact.band`); the caller then does the step again, as a band that wide from the
+        start would have. Returns False, with an error-level warning in `band_errors` (once)
+        and on the console, when band_growth doublings are spent."""
+        if self.band >= self.band_start * 2.0**self.band_growth:
+            if not self.band_errors:
+                self.band_errors.append(
+                    f"the contact zone is cut off at the band's edge (an error: the results are "
+                    f"wrong): active points reach 0.9 of the band {self.band:.4g} at load level "
+                    f"{lam:.4g}, after {self.band_growth} doublings of {self.band_start:.4g} "
+                    "(give a larger band, or band_growth)"
+                )
+                self.log(f"ERROR: {self.band_errors[0]}")
+            return False
+        self.restore()
+        old, band = self.contact, 2.0 * self.band
+        settings = self._rebuild["settings"]
+        with self.phase("contact"):
+            try:
+                new = ContactSet(
+                    self.V, self.scene, band=band, origins=lattice_origins(old),
+                    **dict(settings, mu=old.mu),
+                )  # fmt: skip
+                carry_state(new, old, self.u_committed, self.lam, self.scene.h_contact)
+                failed = ""
+            except (RuntimeError, ValueError) as e:  # e.g. a point outside the rank's cells
+                failed = str(e)
+            failed = next((f for f in self.comm.allgather(failed) if f), "")
+        if failed:
+            raise ContactSolverError(f"contact band {band:.4g}: rebuilding Gamma_c: {failed}")
+        self.contact, self.pairs, self.band = new, new.pairs, band
+        with self.phase("assembly"):
+            self._matrices(self._rebuild["fem"].ghost_penalty)
+        self.retired[0] = self.factorisations
+        self.retired[1] = self.schur_factorisations
+        so = self._rebuild["solver"]
+        with self.phase("solve"):
+            self.linear = linear.choose(self, so.linear_solver, so.petsc_options)
+        self.log(
+            f"contact band doubled to {band:.4g}: active points reached 0.9 of "
+            f"{band / 2:.4g} at load level {lam:.4g}; the step is done again"
+        )
+        return True
+
     # ------------------------------------------------------------------ outputs
     def reaction(self, boundary):
         """Force exerted by the supports on the body at a tagged boundary: the residual
@@ -304,7 +375,9 @@ def solver_metrics(problem, converged=True):
         "cutbacks": int(sum(s.cutback for s in problem.steps)),
         "factorisations": int(problem.factorisations),
         "linear_solver": problem.linear.name,
-        "schur_factorisations": int(getattr(problem.linear, "schur_factorisations", 0)),
+        "schur_factorisations": int(problem.schur_factorisations),
+        # the contact band at the start and at the end (`ContactProblem.grow_band`)
+        "band": {"start": problem.band_start, "end": problem.band},
         "condensed_dofs": int(getattr(problem.linear, "num_dofs", 0)),
         # Krylov iterations per linear solve (the iterative solver only)
         **(
