@@ -333,6 +333,8 @@ def load_steps(problem, num_steps=1, lam_end=1.0, label="step", initial_guess=No
         if ok and getattr(problem, "band_growth", 0) and problem.band_reached():
             if problem.grow_band(target):
                 continue
+            # the growth bound spent: the zone is cut off, the answer wrong (never exit 0)
+            raise ContactSolverError(problem.band_errors[0])
         if ok:
             problem.commit(target)
             problem.steps.append(

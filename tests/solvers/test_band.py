@@ -122,15 +122,14 @@ def test_grown_band_augmented(path):
 @pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial")
 def test_growth_bound_is_an_error_level_warning():
     """band_growth 1 from a band of 0.0125: 0.025 still cuts the zone off (gaps up to 0.05):
-    the run goes on, and says so on the console and first in the warnings; band_growth 0
-    keeps the band (the MPM steps grow theirs) with the band check's warning only."""
-    pb, lines = run("cut", 0.0125, "normal", band_growth=1)
-    assert pb.band == 0.025
-    errors = [line for line in lines if line.startswith("ERROR: the contact zone is cut off")]
-    assert len(errors) == 1
-    w = contact_warnings(pb)
-    assert w[0] == errors[0][len("ERROR: ") :] and "after 1 doublings of 0.0125" in w[0]
-    assert any("within 10 % of the band" in x for x in w[1:])
+    the run ends with a ContactSolverError saying so (a demo: one line, exit 1, nothing
+    written); band_growth 0 keeps the band (the MPM steps grow theirs) with the band check's
+    warning only."""
+    from dolfinx_forms.solvers.newton import ContactSolverError
+
+    with pytest.raises(ContactSolverError, match="cut off at the band's edge") as e:
+        run("cut", 0.0125, "normal", band_growth=1)
+    assert "after 1 doublings of 0.0125" in str(e.value)
     fixed, lines = run("cut", 0.0125, "normal", band_growth=0)
     assert fixed.band == 0.0125 and not fixed.band_errors
     assert not any("band" in line for line in lines)
