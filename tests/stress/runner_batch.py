@@ -10,6 +10,7 @@ description passed every check and the multi-step run (`mpm_runner.run`) would h
 Nothing here is a pytest test; tests/stress/test_hostile_multistep.py starts it.
 """
 
+import importlib.util
 import json
 import os
 import signal
@@ -17,9 +18,11 @@ import sys
 import tempfile
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-import cli_batch  # noqa: E402
+# cli_batch.py beside this file, loaded by path (no sys.path edits: tests/app/test_package.py)
+_file = Path(__file__).with_name("cli_batch.py")
+_spec = importlib.util.spec_from_file_location("cli_batch", _file)
+cli_batch = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(cli_batch)
 
 
 def main(cases_file, results_file):
