@@ -12,7 +12,9 @@ default penalty; p1-tri-al and q1-cut-al the same with --enforcement augmented (
 multipliers, point-wise traction, --multiplier-mass lumped: the closest pressure); q1-cut-al-z1
 is q1-cut-al with the fine zone just covering the contact (--zone 1.0, see
 dolfinx_forms/app/study.py); p1-tri-layers the body-fitted P1 triangles meshed without gmsh
-(--mesher layers: meshes/layers.py) with --zone 1.0 --grading 0.5. Default p1-tri,p1-quad,
+(--mesher layers: meshes/layers.py) with --zone 1.0 --grading 0.5. p1-tri-layers and
+q1-cut-al-z1 are hertz.py's defaults on their paths (meshes/hertz.py path_defaults); the other
+variants name their settings in full (p1-tri: gmsh; q1-cut: the penalty). Default p1-tri,p1-quad,
 q1-cut,p1-tri-al,q1-cut-al,q1-cut-al-z1,p1-tri-layers, so one run compares both paths, both
 enforcements and both meshers.
 
@@ -213,7 +215,7 @@ def code_digest():
     files = [
         DEMO,
         Path(demo.__file__),
-        *sorted((ROOT / "dolfinx_forms").glob("*.py")),
+        *sorted((ROOT / "dolfinx_forms").rglob("*.py")),
         *sorted((ROOT / "dolfinx_forms").glob("_cpp*.so")),
         *sorted((ROOT / "meshes").glob("*.py")),
     ]

@@ -15,8 +15,8 @@ residual history and the phase timings. Hertz keeps the parabola of the cylinder
 errors against the circle itself (`_circle`, to O((a/R)^4)) are there too; they differ by up
 to 0.4 % at the default a/R = 0.1.
 
+Defaults: the fastest accurate settings per path (meshes/hertz.py path_defaults).
 Run: /usr/bin/python3 demos/hertz.py [--discretization cut] [--mu 0.3 --tangential 0.5]
-     [--mesher layers] (body-fitted triangles without gmsh: meshes/layers.py)
 Results and discussion: docs/demos/hertz.md
 """
 
@@ -33,7 +33,7 @@ from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.solvers.protocol import friction_on, reach_force
 from meshes.cut import hertz_cut_scene
 from meshes.hertz import MESHER_OPTIONS, SIZE_OPTIONS, demo_band, demo_sizes, scene_sizes
-from meshes.hertz import hertz_scene
+from meshes.hertz import hertz_scene, path_defaults
 
 PROTOCOL = (
     "rigid approach of the cylinder top, frictionless, iterated to the load P; "
@@ -65,6 +65,7 @@ def parse(argv):
         p.error("--tangential: a Cattaneo-Mindlin stage needs --mu > 0")
     if a.mu > 0 and a.tangential == 0:
         p.error("--mu: friction acts in the tangential stage only: give --tangential r > 0")
+    path_defaults(a, argv)  # the fastest accurate settings of the path, for options not given
     try:  # the mesher; the defaults that depend on the Hertz half-width; what the scene can mesh
         a.width, a.depth, a.h = demo_sizes(a, estimate(vars(a))[1])
     except ValueError as e:

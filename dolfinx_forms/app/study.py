@@ -301,18 +301,21 @@ AL_LUMPED_CUT = [
     "--multiplier-mass",
     "lumped",
 ]
+# Each variant names its settings in full: hertz.py's defaults are the fastest accurate settings
+# of each path (meshes/hertz.py path_defaults), which are the variants p1-tri-layers and
+# q1-cut-al-z1; p1-tri and q1-cut are the gmsh mesh and the penalty they replaced.
 VARIANTS = {  # name -> hertz.py arguments selecting the discretisation
-    "p1-tri": [],
+    "p1-tri": ["--mesher", "gmsh"],
     "p2-tri": ["--degree", "2"],
     "p1-quad": ["--quads"],
     "p2-quad": ["--degree", "2", "--quads"],
-    "q1-cut": ["--discretization", "cut"],
+    "q1-cut": ["--discretization", "cut", "--enforcement", "penalty"],
     # the augmented Lagrangian (P1 multipliers, point-wise traction) on the default meshes,
     # with the lumped projection: the closest pressure (the default hybrid projection zeroes
     # the weighted gap for a coarser one: cut zone 1.0 a, a/20 / a/24 / a/28 1.30 / 0.96 /
     # 0.87 % against 1.11 / 0.78 / 0.75 %)
-    "p1-tri-al": ["--enforcement", "augmented", "--multiplier-mass", "lumped"],
-    "q1-cut-al": AL_LUMPED_CUT,
+    "p1-tri-al": ["--mesher", "gmsh", "--enforcement", "augmented", "--multiplier-mass", "lumped"],
+    "q1-cut-al": [*AL_LUMPED_CUT, "--zone", "1.2"],
     # the same with the fine zone just covering the contact (hertz.py --zone 1.0 a, default
     # 1.2 a): fewer dofs and, with the augmented Lagrangian, a smaller error against Hertz and
     # the fine reference at every h (a/20 ... a/40: 1.11 / 0.78 / 0.75 / 0.76 / 0.64 % against

@@ -39,7 +39,7 @@ def test_contract(study):
     out, d = study
     assert d["discretizations"] == ["cut"] and d["sizes"] == [6, 12]  # sorted coarse to fine
     assert d["variants"] == {"cut": "q1-cut"}
-    assert d["hertz_args"]["cut"] == ["--discretization", "cut"]
+    assert d["hertz_args"]["cut"] == ["--discretization", "cut", "--enforcement", "penalty"]
     assert abs(d["a_hertz"] - 0.99822) < 1e-4
     assert [r["h_divisor"] for r in d["runs"]] == [6, 12]
     for r in d["runs"]:
@@ -113,7 +113,7 @@ def test_work_precision_shares_the_runner():
     # one runner: the benchmark calls the demo module's run_hertz (no second copy)
     assert Path(wp.demo.__file__).resolve() == Path(cs.__file__).resolve()
     assert wp.demo.run_hertz.__code__.co_firstlineno == cs.run_hertz.__code__.co_firstlineno
-    assert wp.VARIANTS["q1-cut"] == ["--discretization", "cut"]
+    assert wp.VARIANTS["q1-cut"] == ["--discretization", "cut", "--enforcement", "penalty"]
     assert wp.parse([]).variants == [
         "p1-tri",
         "p1-quad",
@@ -126,7 +126,7 @@ def test_work_precision_shares_the_runner():
     # the augmented variants with the projection they were measured with (the closest p(x))
     al = wp.VARIANTS["q1-cut-al"]
     assert al[:4] == ["--discretization", "cut", "--enforcement", "augmented"]
-    assert al[4:] == ["--multiplier-mass", "lumped"]
+    assert al[4:] == ["--multiplier-mass", "lumped", "--zone", "1.2"]
     assert wp.parse(["--quick"]).variants == ["p1-tri", "q1-cut"]
     assert wp.loglog_rate([1, 2, 4], [1, 4, 16]) == pytest.approx(2.0)
     assert wp.loglog_rate([1, 1], [1, 2]) is None

@@ -31,21 +31,41 @@ def metrics(out):
     return json.loads((Path(out) / "metrics.json").read_text())
 
 
-_RUNS = {}  # discretization -> output folder of the default Hertz run
-# "layers": body-fitted, meshed by meshes/layers.py instead of gmsh
-ARGS = {"layers": ["--mesher", "layers"]}
+_RUNS = {}  # case -> output folder of its Hertz run
+# conforming: gmsh's triangles; cut: the penalty, zone 1.2 a; layers: body-fitted triangles
+# meshed by meshes/layers.py, on gmsh's zone and grading; defaults-*: hertz.py's defaults, the
+# fastest accurate settings of each path (layers, zone 1.0 a, grading 0.5; cut: augmented,
+# lumped, zone 1.0 a: meshes/hertz.py path_defaults)
+ARGS = {
+    "conforming": ["--mesher", "gmsh"],
+    "cut": ["--discretization", "cut", "--enforcement", "penalty"],
+    "layers": ["--mesher", "layers", "--zone", "1.2", "--grading", "0.25"],
+    "defaults-fitted": [],
+    "defaults-cut": ["--discretization", "cut"],
+}
 
 
-def hertz_run(tmp_path_factory, disc):
-    if disc not in _RUNS:
-        out = tmp_path_factory.mktemp("hertz") / disc
-        r = run("hertz.py", out, *ARGS.get(disc, ["--discretization", disc]))
+def hertz_run(tmp_path_factory, case):
+    if case not in _RUNS:
+        out = tmp_path_factory.mktemp("hertz") / case
+        r = run("hertz.py", out, *ARGS[case])
         assert r.returncode == 0, r.stderr
-        _RUNS[disc] = out
-    return _RUNS[disc]
+        _RUNS[case] = out
+    return _RUNS[case]
 
 
-@pytest.fixture(scope="module", params=["conforming", "cut", "layers"])
+def test_defaults_are_the_fast_settings(tmp_path_factory):
+    """hertz.py's defaults per path: body-fitted P1 triangles in layers (zone 1.0 a, grading
+    0.5), cut with the augmented Lagrangian (lumped, zone 1.0 a, the loop's eps0)."""
+    p = metrics(hertz_run(tmp_path_factory, "defaults-fitted"))["parameters"]
+    assert (p["mesher"], p["zone"], p["grading"], p["enforcement"]) == (
+        "layers", 1.0, 0.5, "penalty")  # fmt: skip
+    p = metrics(hertz_run(tmp_path_factory, "defaults-cut"))["parameters"]
+    assert (p["zone"], p["enforcement"], p["multiplier_mass"], p["eps0"]) == (
+        1.0, "augmented", "lumped", 1e-2)  # fmt: skip
+
+
+@pytest.fixture(scope="module", params=list(ARGS))
 def hertz(tmp_path_factory, request):
     return hertz_run(tmp_path_factory, request.param)
 
@@ -113,6 +133,8 @@ def test_one_newton_solve_one_factorisation(hertz):
     iterations (a secant over whole solves took 4 solves, 21-23 iterations), and the linear
     bulk factorised once (one process: linear.Condensed)."""
     s = metrics(hertz)["solver"]
+    if s["enforcement"] == "augmented":
+        pytest.skip("the penalty's Newton (the Uzawa loop: tests/contact/test_augmented.py)")
     assert s["load_steps"] == 1 and sum(s["newton_iterations"]) <= 6
     assert s["factorisations"] == 1 and s["linear_solver"] == "condensed"
     assert 0 < s["condensed_dofs"] < metrics(hertz)["mesh"]["num_dofs"] // 4
@@ -122,6 +144,8 @@ def test_newton_converges_quadratically(hertz):
     """Penalty contact with linear bulk is piecewise linear: while the active set moves the
     residual falls, once it is settled the exact tangent ends Newton in one step. Check the
     quadratic bound r_{k+1}/r_0 <= 10 (r_k/r_0)^2 on the last iteration of every solve."""
+    if metrics(hertz)["solver"]["enforcement"] == "augmented":
+        pytest.skip("the penalty's Newton (the Uzawa loop: tests/contact/test_augmented.py)")
     hist = metrics(hertz)["solver"]["residual_history"]
     assert hist
     for r in hist:
