@@ -36,7 +36,7 @@ from meshes.plots import brazilian_disc_plots as disc_plots
 
 # fmt: off
 OPTIONS = [  # option, kind, default[, help]
-    ("--R", "(0, inf)", 10.0, "disc radius (mm)"),
+    ("--R", "(0, 1e6]", 10.0, "disc radius (mm)"),
     ("--E", "[1e-3, 1e7]", 100e3, "Young's modulus (N/mm^2; verified 1e-3 to 1e7)"),
     ("--nu", "(-1, 0.5)", 0.3),
     ("--mu", "[0, inf)", 0.5),

@@ -131,7 +131,8 @@ def build_problem(spec, scene, timer=None, log=print):
     loads.update({t["name"]: ld for t, ld in zip(spec["tractions"], tractions)})
     loads.update({f["name"]: ld for f, ld in zip(spec["body_forces"], forces)})
     s = spec["solver"]
-    named = "mu eps0 band grid_refine num_gauss ghost_penalty quadrature_degree cut_degree"
+    named = "mu eps0 band band_growth grid_refine num_gauss ghost_penalty quadrature_degree"
+    named += " cut_degree"
     named += " linear_solver enforcement multiplier_mass"
     problem = ContactProblem(
         scene,

@@ -23,7 +23,8 @@ tan, exp, log, abs):
       both:   contact_box [the pairs' overlaps] (cells owned by MPI rank 0)
   [solver]  enforcement ["penalty" | "augmented"], multiplier_mass ["hybrid" | "consistent" |
       "lumped": augmented only, see ContactProblem], eps0 [1.0; augmented 1e-2: the loop's
-      speed only], band [2 h], mu [0.0], ghost_penalty [0.01], grid_refine [4],
+      speed only], band [2 h], band_growth [4] (doublings of the band while active points
+      reach its edge; spent: an error), mu [0.0], ghost_penalty [0.01], grid_refine [4],
       num_gauss [2], steps [1], quadrature_degree, cut_degree [4], linear_solver ["auto"]
       ("condensed", "factorised", "iterative": dolfinx_forms/solvers/linear.py), petsc {KEY =
       VALUE}, newton {rtol, ftol, atol, stol, max_iterations, max_cutbacks}
@@ -355,6 +356,7 @@ def _solver(t):
         multiplier_mass=mass or (DEFAULT_MULTIPLIER_MASS if enforcement == "augmented" else None),
         eps0=t.number("eps0", eps0, lo=0, lo_open=True),
         band=t.number("band", None, lo=0, lo_open=True),
+        band_growth=t.integer("band_growth", 4, lo=0, hi=10),
         mu=t.number("mu", 0.0, lo=0),
         ghost_penalty=t.number("ghost_penalty", 0.01, lo=0),
         grid_refine=t.integer("grid_refine", 4, lo=1, hi=16),

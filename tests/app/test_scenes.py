@@ -342,3 +342,17 @@ def test_point_condition_off_the_mesh_names_the_nearest_vertex():
         r"vertex \(the nearest is \[0\.0, 0\.0\]\)",
     ):
         run(SCENES / "patch.toml", write=False, overrides=["dirichlet[2].point=[0.01, 0.0]"])
+
+
+def test_band_growth_from_a_description():
+    """solver.band_growth: a band of 0.001 mm on the Hertz scene (h = 0.1) doubles up to 0.064
+    with 6 doublings allowed (the contact's initial gaps reach ~0.05); with the default 4 (to
+    0.016) the zone stays cut off and the run ends with that error, nothing written."""
+    from dolfinx_forms.app import run as run_scene
+    from dolfinx_forms.solvers.newton import ContactSolverError
+
+    sets = ["discretization.h=0.1", "solver.band=0.001", "checks=[]"]
+    r = run_scene(SCENES / "hertz.toml", write=False, overrides=[*sets, "solver.band_growth=6"])
+    assert r.metrics["solver"]["band"] == {"start": 0.001, "end": 0.064}
+    with pytest.raises(ContactSolverError, match="cut off at the band's edge"):
+        run_scene(SCENES / "hertz.toml", write=False, overrides=sets)
