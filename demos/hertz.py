@@ -63,6 +63,8 @@ def parse(argv):
     a = p.parse_args(argv)
     if a.tangential > 0 and a.mu == 0:
         p.error("--tangential: a Cattaneo-Mindlin stage needs --mu > 0")
+    if a.tangential == 0 and any(str(t).startswith("--tangential-steps") for t in argv):
+        p.error("--tangential-steps: steps of the tangential stage: give --tangential r > 0")
     if a.mu > 0 and a.tangential == 0:
         p.error("--mu: friction acts in the tangential stage only: give --tangential r > 0")
     path_defaults(a, argv)  # the fastest accurate settings of the path, for options not given

@@ -73,7 +73,26 @@ class DemoParser(argparse.ArgumentParser):
         self._out_dest = "out"
 
     def parse_args(self, args=None, namespace=None):
+        """Parse and check; under MPI the ranks agree: a refusal on one rank only (an --out
+        folder that exists on its node alone) ends every rank with exit 2, not a hang."""
         same_on_every_rank(self, sys.argv[1:] if args is None else args)
+        from mpi4py import MPI
+
+        comm, stop = MPI.COMM_WORLD, None
+        try:
+            a = self._parse(args, namespace)
+        except SystemExit as e:
+            stop = e
+        if comm.size > 1:
+            codes = comm.allgather(None if stop is None else (stop.code or 0))
+            other = next((c for c in codes if c is not None), None)
+            if stop is None and other is not None:
+                sys.exit(other)  # another rank refused: its message is on stderr
+        if stop is not None:
+            raise stop
+        return a
+
+    def _parse(self, args, namespace):
         a = super().parse_args(args, namespace)
         if getattr(self, "_discretization", False):  # add_discretization
             check_discretization(self, a)

@@ -95,6 +95,12 @@ class Run:
             from dolfinx_forms.io import output
 
             output.stop_plot_worker()
+        if kind is SystemExit and error.code not in (0, None) and self.comm.size > 1:
+            # one rank leaving mid-run would leave the others in their next collective
+            sys.stdout.flush()
+            sys.stderr.write(f"{self.prog}: rank {self.comm.rank} exited ({error.code})\n")
+            sys.stderr.flush()
+            self.comm.Abort(error.code if isinstance(error.code, int) else 1)
         if kind is not None and issubclass(kind, ContactSolverError):
             if self.comm.size > 1:
                 # one rank may fail alone (a step's geometry on its part): the others would

@@ -155,3 +155,50 @@ def test_ranks_that_read_different_descriptions_stop(tmp_path):
     assert r.returncode == 2, r.stderr[-2000:]
     assert "rank 1 read another description than rank 0" in r.stderr
     assert not out.exists()
+
+
+def test_system_exit_on_one_rank_mid_run_ends_all(tmp_path):
+    """sys.exit(3) on rank 1 inside a run (demo.Run) while rank 0 waits in a collective: every
+    rank ends within seconds with one line naming the rank."""
+    script = textwrap.dedent(
+        """
+        import sys
+        import time
+        import dolfinx_forms.app  # noqa: F401
+        from dolfinx_forms.app.demo import Run
+        with Run("x", {}, plot=False) as run:
+            if run.comm.rank == 1:
+                sys.exit(3)
+            run.comm.barrier()  # rank 0 would wait here forever
+            time.sleep(300)
+    """
+    )
+    (tmp_path / "exit_on_rank_1.py").write_text(script)
+    r, wall = mpirun(["exit_on_rank_1.py"], timeout=120, cwd=tmp_path)
+    assert r.returncode != 0
+    assert wall < 20, f"took {wall:.1f} s"
+    assert "exit_on_rank_1.py: rank 1 exited (3)" in r.stderr.splitlines()
+
+
+def test_refusal_on_one_rank_only_ends_all(tmp_path):
+    """The same command line, but --out names a foreign folder on rank 1's side only (one
+    working folder per rank, MPMD): rank 1 refuses, rank 0 (which passed) exits 2 with it, within
+    seconds, and nothing is written."""
+    exe = shutil.which("mpirun")
+    if exe is None or MPI.COMM_WORLD.size > 1:
+        pytest.skip("no mpirun, or already under mpirun (no nested launch)")
+    demo = [sys.executable, str(ROOT / "demos" / "patch_test.py"), "--out", "out"]
+    cmd = [exe]
+    for rank in (0, 1):
+        (d := tmp_path / f"rank{rank}").mkdir()
+        cmd += ([":"] if rank else []) + ["-n", "1", "--wdir", str(d), *demo]
+    (tmp_path / "rank1" / "out").mkdir()
+    (tmp_path / "rank1" / "out" / "mine.txt").write_text("not a result")  # a foreign folder
+    env = dict(os.environ, **MPI_ENV, PYTHONPATH=str(ROOT))
+    t0 = time.perf_counter()
+    r = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=120)
+    assert time.perf_counter() - t0 < 30
+    assert r.returncode == 2, r.stderr[-2000:]
+    assert "--out" in r.stderr
+    assert not (tmp_path / "rank0" / "out").exists()
+    assert sorted(p.name for p in (tmp_path / "rank1" / "out").iterdir()) == ["mine.txt"]

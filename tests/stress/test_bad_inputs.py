@@ -87,6 +87,7 @@ CASES = [
     ("hertz", "--gauss 0", "--gauss"),
     ("hertz", "--steps 0", "--steps"),
     ("hertz", "--tangential-steps 1", "--tangential-steps"),
+    ("hertz", "--tangential-steps 5", "--tangential-steps"),  # without --tangential
     ("two_blocks", "--steps 101", "--steps"),
     ("inclined_interface", "--grid-refine 0", "--grid-refine"),
     ("inclined_interface", "--gauss 6", "--gauss"),
