@@ -291,6 +291,30 @@ def _analytic(t, bodies, obstacles):
     return {"type": kind, "body": body, "obstacle": ob, "R": b["shape"]["radius"]}
 
 
+RESULTS = ("steps", "equilibrium_rel_max", "area_vs_points_rel_max", "mass_rel_change_max",
+           "newton_iterations_mean", "contacts_final", "obstacle_forces", "band_final")  # fmt: skip
+HERTZ_RESULTS = ("half_width", "steps_judged", "half_width_rel_error_max")
+
+
+def _check_path(path, key, spec):
+    """A check's metrics path under results or analytic names what a multi-step run writes
+    (mpm_runner.evaluate): refused here, not at the end of the run."""
+    import re
+
+    parts = re.findall(r"[^.\[\]]+", path)
+    known = {"results": RESULTS + (HERTZ_RESULTS if spec["analytic"] else ()),
+             "analytic": ("half_width",) if spec["analytic"] else ()}  # fmt: skip
+    if parts[0] not in known:
+        return  # solver, mesh, timing_s: the contract's blocks
+    if len(parts) < 2 or parts[1] not in known[parts[0]]:
+        names = ", ".join(known[parts[0]]) or "none (no [analytic])"
+        raise SpecError(key, f"{path!r}: a multi-step run writes {parts[0]}.{{{names}}}")
+    if parts[1] == "obstacle_forces":
+        obstacles = [o["name"] for o in spec["obstacles"]]
+        if len(parts) < 3 or parts[2] not in obstacles:
+            raise SpecError(key, f"{path!r}: obstacle_forces.<one of {', '.join(obstacles)}>")
+
+
 def validate(data, base_dir=None, default_name="scene"):
     """Check a multi-step description (a dict, as read from TOML) and return a new dict with
     every default filled in. Raises SpecError naming the first bad key."""
@@ -325,6 +349,10 @@ def validate(data, base_dir=None, default_name="scene"):
     an = top.table("analytic", None)
     spec["analytic"] = None if an is None else _analytic(an, spec["bodies"], spec["obstacles"])
     spec["checks"] = [_check(c) for c in top.tables("checks")]
+    for i, c in enumerate(spec["checks"]):
+        for k in ("quantity", "close_to", "below", "above"):
+            if isinstance(c[k], str):
+                _check_path(c[k], f"checks[{i}].{k}", spec)
     top.done()
     from dolfinx_forms.app import scene_geometry
 

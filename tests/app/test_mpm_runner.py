@@ -128,6 +128,11 @@ BAD = [  # (override, the key the message names, a word of the message)
     ("method='multi'", "method", "mpm"),
     ("bodies[0].name=''", "bodies[0].name", "empty"),
     ("obstacles[0].name=' '", "obstacles[0].name", "empty"),
+    ("checks=[{quantity='results.nothing', below=1.0}]", "checks[0].quantity", "writes"),
+    ("checks=[{quantity='results.obstacle_forces.wall[1]', below=1.0}]", "checks[0].quantity",
+     "floor"),
+    ("checks=[{quantity='results.half_width_rel_error_max', below=1.0}]", "checks[0].quantity",
+     "writes"),
 ]  # fmt: skip
 
 
