@@ -218,7 +218,7 @@ def summary(run):
 # --------------------------------------------------------------------------- run
 def make_simulation(spec, comm, timer=None, log=print):
     """(ImplicitMPM, obstacles {name: RigidObstacle}, dirichlet {name: Dirichlet})."""
-    from dolfinx_forms.app.scene_spec import make_law
+    from dolfinx_forms.app.spec_values import make_law
     from dolfinx_forms.mesh.from_spec import shape_of
     from dolfinx_forms.mesh.grid_scene import grid_scene
     from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody

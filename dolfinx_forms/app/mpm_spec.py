@@ -1,9 +1,9 @@
 """Multi-step scene descriptions (`method = "mpm"`): deformable level-set bodies carrying
 material points, rigid obstacles moved step by step or to a force, run by the implicit MPM
 (`dolfinx_forms.mpm.implicit.ImplicitMPM`, `mpm_runner.run`). Read and checked here, like the
-single-step descriptions (scene_spec.py, whose value rules, shapes, laws, `[solver.petsc]`,
-`[solver.newton]`, `[[checks]]`, `extends` and `--set` these share). Keys (defaults in brackets;
-lengths and forces in the scene's units, angles in degrees):
+single-step descriptions (scene_spec.py: `extends`, `--set`; the value rules, shapes, laws,
+`[solver.petsc]`, `[solver.newton]` and `[[checks]]` of both: spec_values.py). Keys (defaults
+in brackets; lengths and forces in the scene's units, angles in degrees):
 
   method = "mpm", name ["scene"; the file's stem], description [""]
   [units]  length [""], force [""]: the labels of the plots ("mm", "N")
@@ -44,15 +44,15 @@ import copy
 
 import numpy as np
 
-from dolfinx_forms.app.scene_spec import (
+from dolfinx_forms.app.spec_values import (
     SpecError,
-    _check,
-    _Table,
-    _component,
-    _law,
-    _name,
-    _shape,
+    Table,
+    name_ref,
     newton_table,
+    parse_check,
+    parse_component,
+    parse_law,
+    parse_shape,
     petsc_table,
     plain_name,
 )
@@ -143,13 +143,13 @@ def _bodies(top, base_dir):
             raise SpecError(b.path("name"), "must not be empty")
         if name in bodies:
             raise SpecError(b.path("name"), f"duplicate body name {name!r}")
-        shape = _shape(b.table("shape"), base_dir)
+        shape = parse_shape(b.table("shape"), base_dir)
         if shape["type"] == "half_plane":
             raise SpecError(
                 b.path("shape.type"), "a deformable body must be bounded (a half-plane can be "
                 "a rigid obstacle: [[obstacles]])"
             )
-        law = _law(b.table("law"))
+        law = parse_law(b.table("law"))
         if law["type"] not in MPM_LAWS:
             raise SpecError(
                 b.path("law.type"),
@@ -171,7 +171,7 @@ def _obstacles(top, base_dir, body_names):
             raise SpecError(o.path("name"), "must not be empty")
         if name in out or name in body_names:
             raise SpecError(o.path("name"), f"duplicate name {name!r} (bodies and obstacles)")
-        shape = _shape(o.table("shape"), base_dir)
+        shape = parse_shape(o.table("shape"), base_dir)
         touch = o.raw("bodies", None)
         if touch is not None and (
             not isinstance(touch, list) or not touch or any(n not in body_names for n in touch)
@@ -194,7 +194,7 @@ def _dirichlet(top, grid):
         box = t.table("box")
         b = {k: box.number(k, None) for k in ("x_min", "x_max", "y_min", "y_max")}
         box.done()
-        d = {"box": b, "component": _component(t, "component", "all")}
+        d = {"box": b, "component": parse_component(t, "component", "all")}
         if d["component"] == "z":
             raise SpecError(t.path("component"), "must be 'x', 'y' or 'all' (scenes are 2D)")
         d["value"] = t.number("value", 0.0)
@@ -244,8 +244,8 @@ def _stage(t, i, obstacles, dirichlet, h):
     tg = t.table("target", None)
     st["target"] = None
     if tg is not None:
-        ob = _name(tg, "obstacle", list(obstacles), "obstacle")
-        comp = _component(tg, "component", "all")
+        ob = name_ref(tg, "obstacle", list(obstacles), "obstacle")
+        comp = parse_component(tg, "component", "all")
         if comp not in ("x", "y"):
             raise SpecError(tg.path("component"), f"must be 'x' or 'y', got {comp!r}")
         st["target"] = dict(
@@ -280,8 +280,8 @@ def _stage(t, i, obstacles, dirichlet, h):
 
 def _analytic(t, bodies, obstacles):
     kind = t.string("type", choices=("hertz",))
-    body = _name(t, "body", [b["name"] for b in bodies], "body")
-    ob = _name(t, "obstacle", [o["name"] for o in obstacles], "obstacle")
+    body = name_ref(t, "body", [b["name"] for b in bodies], "body")
+    ob = name_ref(t, "obstacle", [o["name"] for o in obstacles], "obstacle")
     b = next(x for x in bodies if x["name"] == body)
     if b["shape"]["type"] != "circle" or b["law"]["type"] != "linear":
         raise SpecError(t.path("body"), "the hertz reference needs a circle with a linear law")
@@ -318,7 +318,7 @@ def _check_path(path, key, spec):
 def validate(data, base_dir=None, default_name="scene"):
     """Check a multi-step description (a dict, as read from TOML) and return a new dict with
     every default filled in. Raises SpecError naming the first bad key."""
-    top = _Table(copy.deepcopy(data), "")
+    top = Table(copy.deepcopy(data), "")
     name = plain_name(top, default_name)
     top.string("method", choices=("mpm",))
     spec = {"method": "mpm", "name": name, "description": top.string("description", "")}
@@ -348,7 +348,7 @@ def validate(data, base_dir=None, default_name="scene"):
     out.done()
     an = top.table("analytic", None)
     spec["analytic"] = None if an is None else _analytic(an, spec["bodies"], spec["obstacles"])
-    spec["checks"] = [_check(c) for c in top.tables("checks")]
+    spec["checks"] = [parse_check(c) for c in top.tables("checks")]
     for i, c in enumerate(spec["checks"]):
         for k in ("quantity", "close_to", "below", "above"):
             if isinstance(c[k], str):

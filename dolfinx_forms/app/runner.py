@@ -26,7 +26,7 @@ from mpi4py import MPI
 from dolfinx_forms.analysis import analytic, compare
 from dolfinx_forms.app.checks import RunResult, evaluate_checks
 from dolfinx_forms.app.description import load
-from dolfinx_forms.app.scene_spec import FUNCTIONS, SpecError, make_law
+from dolfinx_forms.app.spec_values import FUNCTIONS, SpecError, make_law
 from dolfinx_forms.solvers import protocol
 
 __all__ = ["run", "RunResult", "evaluate_checks"]

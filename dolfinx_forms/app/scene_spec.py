@@ -1,7 +1,8 @@
 """Scene descriptions: read, check and complete a TOML (or dict) description of a contact run.
 
 A description names the bodies (shape, law), the discretization, boundaries, conditions,
-load stages, outputs and checks; `runner.run` executes it. This module is pure Python: it
+load stages, outputs and checks; `runner.run` executes it (the value rules shared with the
+multi-step descriptions: spec_values.py). This module is pure Python: it
 reads and checks (one `SpecError` naming the key, e.g. ``bodies[1].shape.radius: must be > 0,
 got -1``) and returns the description with every default filled in, which metrics.json
 records as its parameters. Keys (defaults in brackets; "box" is [[x_min, y_min], [x_max, y_max]],
@@ -56,248 +57,28 @@ tan, exp, log, abs):
 
 from __future__ import annotations
 
-import ast
 import copy
-import math
-import re
 import tomllib
 from pathlib import Path
 
-import numpy as np
-
+from dolfinx_forms.app.spec_values import (  # noqa: F401  (parse_expression: API)
+    REQUIRED,
+    SIDES,
+    Table,
+    as_number,
+    name_ref,
+    newton_table,
+    parse_check,
+    parse_component,
+    parse_expression,
+    parse_law,
+    parse_shape,
+    petsc_table,
+    plain_name,
+)
 from dolfinx_forms.common import SpecError  # noqa: F401  (raised here; its home is common)
 
 __all__ = ["SpecError", "load", "validate", "apply_overrides", "parse_expression", "SIDES"]
-
-SIDES = ("left", "right", "bottom", "top")
-COMPONENTS = {"x": 0, "y": 1, "z": 2}
-LAW_PARAMETERS = {  # type -> (required, optional with defaults); laws.LAWS builds them
-    "linear": (("E", "nu"), {}),
-    "orthotropic": (("E1", "E2", "E3", "nu12", "nu13", "nu23", "G12"), {"angle": 0.0}),
-    "neo-hookean": (("E", "nu"), {}),
-}
-BOUNDS = {"nu": dict(lo=-1, hi=0.5, lo_open=True, hi_open=True)}  # others: moduli > 0
-BOUNDS.update({k: dict(lo=0, lo_open=True) for k in ("E", "E1", "E2", "E3", "G12")})
-SHAPES = {  # type -> (required, optional with defaults)
-    "circle": (("centre", "radius"), {}),
-    "ellipse": (("centre", "axes"), {"angle": 0.0}),
-    "box": (("min", "max"), {}),
-    "polygon": ((), {"points": None, "file": None}),
-    "half_plane": (("point", "normal"), {}),
-}
-CHECK_ROOTS = ("results", "analytic", "solver", "mesh", "timing_s")
-FUNCTIONS = ("sqrt", "sin", "cos", "tan", "exp", "log", "abs")
-# a scene's name: the folder of its results under ./results (no path, nothing outside)
-NAME = re.compile(r"[A-Za-z0-9_.-]{1,100}")
-_REQUIRED = object()
-
-
-# --------------------------------------------------------------------------- values
-def _number(v, key, lo=None, hi=None, lo_open=False, hi_open=False, integer=False):
-    ok = isinstance(v, int) if integer else isinstance(v, (int, float))
-    if isinstance(v, bool) or not ok or not math.isfinite(v):
-        raise SpecError(key, f"must be {'an integer' if integer else 'a number'}, got {v!r}")
-    if lo is not None and (v <= lo if lo_open else v < lo):
-        raise SpecError(key, f"must be {'>' if lo_open else '>='} {lo}, got {v}")
-    if hi is not None and (v >= hi if hi_open else v > hi):
-        raise SpecError(key, f"must be {'<' if hi_open else '<='} {hi}, got {v}")
-    return int(v) if integer else float(v)
-
-
-def _point(v, key):
-    if not isinstance(v, list) or len(v) not in (2, 3):
-        raise SpecError(key, f"must be a point [x, y], got {v!r}")
-    return [_number(c, f"{key}[{i}]") for i, c in enumerate(v)]
-
-
-def _box(v, key):
-    if not isinstance(v, list) or len(v) != 2:
-        raise SpecError(key, f"must be a box [[x_min, y_min], [x_max, y_max]], got {v!r}")
-    lo, hi = _point(v[0], f"{key}[0]"), _point(v[1], f"{key}[1]")
-    if len(lo) != len(hi) or not all(a < b for a, b in zip(lo, hi)):
-        raise SpecError(key, f"needs min < max in every coordinate, got {v!r}")
-    return [lo, hi]
-
-
-MAX_EXPRESSION = 1000  # characters of an expression
-MAX_EXPONENT = 100  # |constant exponent| of a power
-# where an expression is tried at validation: a few generic points (no zeros, no symmetries)
-SAMPLES = np.array([[0.37, 1.13, 2.71, -0.59, 5.3], [0.83, -1.7, 0.11, 3.9, 2.2]])
-
-
-def parse_expression(text, key, names=("x", "y", "z")):
-    """Check an expression (number or string) and return it (a float or the string). A string
-    is at most MAX_EXPRESSION characters of arithmetic on the names, numbers and FUNCTIONS;
-    every power has a constant exponent of size at most MAX_EXPONENT (so no `9**9**9`); it is
-    evaluated once at SAMPLES (floats: no integer overflow, no exception) and refused if it is
-    finite at none of them (`1/0`, `sqrt(-1.0)`, `exp(1000.0)`)."""
-    if not isinstance(text, str):
-        return _number(text, key)
-    if len(text) > MAX_EXPRESSION:
-        raise SpecError(
-            key, f"an expression of at most {MAX_EXPRESSION} characters, got {len(text)}"
-        )
-    try:
-        tree = ast.parse(text, mode="eval")
-    except SyntaxError:
-        raise SpecError(key, f"not an expression: {text!r}") from None
-    allowed = set(names) | set(FUNCTIONS) | {"pi"}
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Name) and node.id not in allowed:
-            raise SpecError(
-                key,
-                f"unknown name {node.id!r} in {text!r} (allowed: {', '.join(sorted(allowed))})",
-            )
-        if isinstance(node, ast.Call) and not (
-            isinstance(node.func, ast.Name) and node.func.id in FUNCTIONS
-        ):
-            raise SpecError(key, f"only {', '.join(FUNCTIONS)} may be called in {text!r}")
-        if not isinstance(
-            node,
-            (
-                ast.Expression,
-                ast.BinOp,
-                ast.UnaryOp,
-                ast.Constant,
-                ast.Name,
-                ast.Call,
-                ast.Load,
-                ast.operator,
-                ast.unaryop,
-            ),
-        ):
-            raise SpecError(key, f"unsupported syntax in {text!r}")
-        if isinstance(node, ast.Constant) and not isinstance(node.value, (int, float)):
-            raise SpecError(key, f"only numbers are allowed in {text!r}")
-        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
-            e = node.right
-            if isinstance(e, ast.UnaryOp) and isinstance(e.op, (ast.USub, ast.UAdd)):
-                e = e.operand
-            if not (isinstance(e, ast.Constant) and abs(e.value) <= MAX_EXPONENT):
-                raise SpecError(
-                    key, f"a power's exponent must be a number in [-{MAX_EXPONENT}, "
-                    f"{MAX_EXPONENT}] in {text!r}"
-                )
-    if not np.any(np.isfinite(_sample(tree, names))):
-        raise SpecError(
-            key, f"{text!r} is not a finite number (tried at {SAMPLES.shape[1]} points)"
-        )
-    return text
-
-
-def _sample(tree, names):
-    """The expression `tree` (checked by parse_expression) at SAMPLES, in float64 numpy."""
-    env = {n: SAMPLES[i % 2] for i, n in enumerate(names)}
-    env.update({f: getattr(np, f) for f in FUNCTIONS}, pi=np.pi, np=np)
-    code = compile(ast.fix_missing_locations(_FloatConstants().visit(tree)), "<spec>", "eval")
-    with np.errstate(all="ignore"):
-        try:
-            v = eval(code, {"__builtins__": {}}, env)  # names, numbers and FUNCTIONS only
-        except (ArithmeticError, ValueError):
-            return np.full(SAMPLES.shape[1], np.nan)
-    return np.broadcast_to(np.asarray(v, dtype=float), SAMPLES.shape[1:])
-
-
-class _FloatConstants(ast.NodeTransformer):
-    """Integer constants as numpy floats: `1/0` and `2**1000` overflow to inf, not raise."""
-
-    def visit_Constant(self, node):
-        f = ast.Attribute(ast.Name("np", ast.Load()), "float64", ast.Load())
-        return ast.Call(f, [node], [])
-
-
-class _Table:
-    """One table of the description: typed reads with defaults, unknown keys refused."""
-
-    def __init__(self, data, key):
-        if not isinstance(data, dict):
-            raise SpecError(key, f"must be a table, got {data!r}")
-        self.data, self.key, self.used = data, key, set()
-
-    def path(self, k):
-        return f"{self.key}.{k}" if self.key else k
-
-    def has(self, k):
-        return k in self.data
-
-    def raw(self, k, default=_REQUIRED):
-        self.used.add(k)
-        if k not in self.data:
-            if default is _REQUIRED:
-                raise SpecError(self.path(k), "missing")
-            return default
-        return self.data[k]
-
-    def number(self, k, default=_REQUIRED, **bounds):
-        if k not in self.data:
-            return self.raw(k, default)
-        return _number(self.raw(k), self.path(k), **bounds)
-
-    def integer(self, k, default=_REQUIRED, **bounds):
-        return self.number(k, default, integer=True, **bounds)
-
-    def string(self, k, default=_REQUIRED, choices=None):
-        if k not in self.data:
-            return self.raw(k, default)
-        v = self.raw(k)
-        if not isinstance(v, str):
-            raise SpecError(self.path(k), f"must be a string, got {v!r}")
-        if choices is not None and v not in choices:
-            raise SpecError(
-                self.path(k), f"must be one of {', '.join(map(repr, choices))}, got {v!r}"
-            )
-        return v
-
-    def boolean(self, k, default=_REQUIRED):
-        v = self.raw(k, default)
-        if not isinstance(v, bool):
-            raise SpecError(self.path(k), f"must be true or false, got {v!r}")
-        return v
-
-    def box(self, k, default=_REQUIRED):
-        v = self.raw(k, default)
-        return v if v is None else _box(v, self.path(k))
-
-    def point(self, k, default=_REQUIRED):
-        v = self.raw(k, default)
-        return v if v is None else _point(v, self.path(k))
-
-    def table(self, k, default=_REQUIRED):
-        v = self.raw(k, default)
-        return None if v is None else _Table(v, self.path(k))
-
-    def tables(self, k):
-        v = self.raw(k, [])
-        if not isinstance(v, list):
-            raise SpecError(self.path(k), f"must be an array of tables ([[{k}]]), got {v!r}")
-        return [_Table(item, f"{self.path(k)}[{i}]") for i, item in enumerate(v)]
-
-    def done(self):
-        unknown = set(self.data) - self.used
-        if unknown:
-            k = sorted(unknown)[0]
-            known = ", ".join(sorted(self.used))
-            raise SpecError(self.path(k), f"unknown key (expected one of: {known})")
-
-
-def _name(t, k, names, what, default=_REQUIRED):
-    """A reference to one of `names` (e.g. a body name)."""
-    v = t.string(k, default)
-    if v is not None and v not in names:
-        raise SpecError(t.path(k), f"unknown {what} {v!r} (known: {', '.join(names) or 'none'})")
-    return v
-
-
-def _component(t, k, default):
-    v = t.raw(k, default)
-    if v in ("all", None):
-        return "all"
-    if isinstance(v, int) and not isinstance(v, bool) and 0 <= v <= 2:
-        return "xyz"[v]
-    if v not in COMPONENTS:
-        raise SpecError(t.path(k), f"must be one of 'x', 'y', 'z', 'all', got {v!r}")
-    return v
-
 
 # --------------------------------------------------------------------------- sections
 def _discretization(t):
@@ -312,7 +93,7 @@ def _discretization(t):
         if cells is not None:
             if not isinstance(cells, list) or len(cells) != len(d["extent"][0]):
                 raise SpecError(t.path("cells"), f"must be [n_x, n_y], got {cells!r}")
-            cells = [_number(n, f"{t.path('cells')}[{i}]", lo=1, integer=True)
+            cells = [as_number(n, f"{t.path('cells')}[{i}]", lo=1, integer=True)
                      for i, n in enumerate(cells)]  # fmt: skip
             if d["fine"] is not None:
                 raise SpecError(t.path("cells"), "is for uniform grids (no `fine`)")
@@ -374,98 +155,6 @@ def _solver(t):
     return s
 
 
-def petsc_table(t, linear_solver):
-    """`t.petsc` {KEY = VALUE}: strings, checked as the demos' --petsc (cli.check_petsc)."""
-    petsc = t.table("petsc", {})
-    out = {}
-    for k, v in petsc.data.items():
-        if isinstance(v, (dict, list)):
-            raise SpecError(petsc.path(k), f"must be a string or a number, got {v!r}")
-        out[k] = str(v).lower() if isinstance(v, bool) else str(v)
-    if out or linear_solver == "condensed":  # checked as the demos' --petsc
-        from dolfinx_forms.app.cli import ITERATIVE_DEFAULTS, check_petsc
-
-        base = ITERATIVE_DEFAULTS if linear_solver == "iterative" else None
-        why = check_petsc(out, base, linear_solver)
-        if why is not None:
-            raise SpecError(t.path("petsc"), why)
-    return out
-
-
-def newton_table(t):
-    """`t.newton` {rtol, ftol, atol, stol, max_iterations, max_cutbacks}: the given ones."""
-    newton = t.table("newton", {})
-    out = {k: newton.number(k, None, lo=0, lo_open=True) for k in ("rtol", "ftol", "atol", "stol")}
-    for k, lo in (("max_iterations", 1), ("max_cutbacks", 0)):
-        out[k] = newton.integer(k, None, lo=lo)
-    newton.done()
-    return {k: v for k, v in out.items() if v is not None}
-
-
-def _shape(t, base_dir):
-    kind = t.string("type", choices=tuple(SHAPES))
-    s = {"type": kind}
-    if kind == "circle":
-        s.update(centre=t.point("centre"), radius=t.number("radius", lo=0, lo_open=True))
-    elif kind == "ellipse":
-        s.update(centre=t.point("centre"), angle=t.number("angle", 0.0))
-        axes = t.raw("axes")
-        if not isinstance(axes, list) or len(axes) != 2:
-            raise SpecError(t.path("axes"), f"must be [a, b], got {axes!r}")
-        s["axes"] = [
-            _number(a, f"{t.path('axes')}[{i}]", lo=0, lo_open=True) for i, a in enumerate(axes)
-        ]
-    elif kind == "box":
-        s["min"], s["max"] = _box([t.raw("min"), t.raw("max")], t.key)
-    elif kind == "polygon":
-        pts, file = t.raw("points", None), t.string("file", None)
-        if (pts is None) == (file is None):
-            raise SpecError(t.path("points"), "give exactly one of points and file")
-        if file is not None:
-            path = Path(base_dir or ".") / file
-            try:
-                rows = [ln.replace(",", " ").split() for ln in path.read_text().splitlines()]
-                pts = [[float(c) for c in r] for r in rows if r and not r[0].startswith("#")]
-            except (OSError, ValueError) as e:
-                raise SpecError(t.path("file"), f"cannot read points from {path}: {e}") from None
-            s["file"] = file
-        if not isinstance(pts, list) or len(pts) < 3:
-            raise SpecError(
-                t.path("points" if file is None else "file"), "a polygon needs at least 3 points"
-            )
-        s["points"] = [_point(p, f"{t.path('points')}[{i}]") for i, p in enumerate(pts)]
-    else:
-        s.update(point=t.point("point"), normal=t.point("normal"))
-        if not any(s["normal"]):
-            raise SpecError(t.path("normal"), "must not be zero")
-    t.done()
-    return s
-
-
-def make_law(law):
-    """The solver material of a checked law description: the one place where a description
-    becomes a `laws.Law` (angles in the description are in degrees)."""
-    from dolfinx_forms.fem.laws import LAWS
-
-    params = {k: v for k, v in law.items() if k != "type"}
-    return LAWS[law["type"]](**params)
-
-
-def _law(t):
-    kind = t.string("type", choices=tuple(LAW_PARAMETERS))
-    required, optional = LAW_PARAMETERS[kind]
-    law = {
-        "type": kind,
-        **{k: t.number(k, **BOUNDS.get(k, {})) for k in required},
-        **{k: t.number(k, v) for k, v in optional.items()},
-    }
-    t.done()
-    try:
-        make_law(law)
-    except ValueError as e:
-        raise SpecError(t.key, str(e)) from None
-    return law
-
 
 def _stage(t, i, loads, dirichlet, boundaries, default_steps):
     kind = t.string("kind", choices=("ramp", "force", "friction"))
@@ -486,15 +175,15 @@ def _stage(t, i, loads, dirichlet, boundaries, default_steps):
             st["to"] = None
         st["steps"] = t.integer("steps", default_steps, lo=1, hi=1000)
     elif kind == "force":
-        name = _name(t, "dirichlet", list(dirichlet), "Dirichlet condition")
+        name = name_ref(t, "dirichlet", list(dirichlet), "Dirichlet condition")
         bc = dirichlet[name]
         st.update(
             dirichlet=name,
-            boundary=_name(t, "boundary", boundaries, "boundary", bc.get("boundary")),
+            boundary=name_ref(t, "boundary", boundaries, "boundary", bc.get("boundary")),
         )
         if st["boundary"] is None:
             raise SpecError(t.path("boundary"), "missing (the condition is on a point)")
-        st["component"] = _component(t, "component", bc["component"])
+        st["component"] = parse_component(t, "component", bc["component"])
         if st["component"] == "all" or bc["component"] not in ("all", st["component"]):
             raise SpecError(
                 t.path("component"), f"must be the component the condition {name!r} prescribes"
@@ -520,13 +209,13 @@ def _stage(t, i, loads, dirichlet, boundaries, default_steps):
     return st
 
 
-def _force_ref(t, k, boundaries, default=_REQUIRED):
+def _force_ref(t, k, boundaries, default=REQUIRED):
     r = t.table(k, default)
     if r is None:
         return None
     out = {
-        "boundary": _name(r, "boundary", boundaries, "boundary"),
-        "component": _component(r, "component", _REQUIRED),
+        "boundary": name_ref(r, "boundary", boundaries, "boundary"),
+        "component": parse_component(r, "component", REQUIRED),
     }
     if out["component"] == "all":
         raise SpecError(r.path("component"), "must be 'x', 'y' or 'z'")
@@ -549,46 +238,13 @@ def _analytic(t, bodies, pairs, boundaries):
         a.update(
             displacement=t.number("displacement", lo=0, lo_open=True),
             height=t.number("height", lo=0, lo_open=True),
-            body=_name(t, "body", list(bodies), "body", next(iter(bodies))),
+            body=name_ref(t, "body", list(bodies), "body", next(iter(bodies))),
         )
     for name in a.get("bodies", [a.get("body")]):
         if bodies[name]["law"]["type"] != "linear":
             raise SpecError(t.path("type"), f"the {kind} reference needs linear laws ({name!r})")
     t.done()
     return a
-
-
-def _path_or_number(t, k):
-    v = t.raw(k, None)
-    if v is None or not isinstance(v, str):
-        return v if v is None else _number(v, t.path(k))
-    _metric_path(v, t.path(k))
-    return v
-
-
-def _metric_path(v, key):
-    root = v.split(".")[0].split("[")[0]
-    if not isinstance(v, str) or root not in CHECK_ROOTS:
-        raise SpecError(
-            key,
-            f"must be a metrics path starting with one of {', '.join(CHECK_ROOTS)}, got {v!r}",
-        )
-    return v
-
-
-def _check(t):
-    c = {"quantity": _metric_path(t.string("quantity"), t.path("quantity"))}
-    c["label"] = t.string("label", c["quantity"])
-    for k in ("close_to", "below", "above"):
-        c[k] = _path_or_number(t, k)
-    c["rtol"] = t.number("rtol", None, lo=0)
-    c["atol"] = t.number("atol", None, lo=0)
-    if c["close_to"] is None and c["below"] is None and c["above"] is None:
-        raise SpecError(t.key, "give close_to (with rtol or atol), below or above")
-    if c["close_to"] is not None and c["rtol"] is None and c["atol"] is None:
-        raise SpecError(t.path("close_to"), "needs rtol or atol")
-    t.done()
-    return c
 
 
 # --------------------------------------------------------------------------- the description
@@ -601,8 +257,8 @@ def _bodies(top, base_dir):
             raise SpecError(b.path("name"), f"duplicate body name {name!r}")
         bodies[name] = {
             "name": name,
-            "shape": _shape(b.table("shape"), base_dir),
-            "law": _law(b.table("law")),
+            "shape": parse_shape(b.table("shape"), base_dir),
+            "law": parse_law(b.table("law")),
             "window": b.box("window", None),
         }
         if bodies[name]["shape"]["type"] == "half_plane" and bodies[name]["window"] is None:
@@ -640,7 +296,7 @@ def _boundaries(top, names):
         name = b.string("name")
         if name in boundaries:
             raise SpecError(b.path("name"), f"duplicate boundary name {name!r}")
-        bd = {"name": name, "body": _name(b, "body", names, "body", None)}
+        bd = {"name": name, "body": name_ref(b, "body", names, "body", None)}
         if b.has("side") == b.has("box"):
             raise SpecError(b.path("side"), "give exactly one of side and box")
         if b.has("side"):
@@ -683,9 +339,9 @@ def _loads(top, spec, names, bnames):
         if t.has("boundary") == t.has("point"):
             raise SpecError(t.path("boundary"), "give exactly one of boundary and point")
         d = {
-            "boundary": _name(t, "boundary", bnames, "boundary", None),
+            "boundary": name_ref(t, "boundary", bnames, "boundary", None),
             "point": t.point("point", None),
-            "component": _component(t, "component", "all"),
+            "component": parse_component(t, "component", "all"),
         }
         d["value"] = parse_expression(t.raw("value", 0.0), t.path("value"))
         d["name"] = t.string("name", f"{d['boundary'] or 'point'}.{d['component']}")
@@ -695,9 +351,9 @@ def _loads(top, spec, names, bnames):
         spec[section] = []
         for t in top.tables(section):
             ref = (
-                _name(t, "boundary", bnames, "boundary")
+                name_ref(t, "boundary", bnames, "boundary")
                 if where == "boundary"
-                else _name(t, "body", names, "body", None)
+                else name_ref(t, "body", names, "body", None)
             )
             value = t.raw("value")
             if not isinstance(value, list) or len(value) not in (2, 3):
@@ -717,7 +373,7 @@ def _loads(top, spec, names, bnames):
 def validate(data, base_dir=None, default_name="scene"):
     """Check a description (a dict, as read from TOML) and return a new dict with every
     default filled in. Raises SpecError naming the first bad key."""
-    top = _Table(copy.deepcopy(data), "")
+    top = Table(copy.deepcopy(data), "")
     name = plain_name(top, default_name)
     if top.string("method", "single-step") != "single-step":
         raise SpecError(
@@ -753,28 +409,16 @@ def validate(data, base_dir=None, default_name="scene"):
     out = top.table("outputs", {})
     first = next((d["boundary"] for d in spec["dirichlet"] if d["boundary"]), None)
     spec["outputs"] = {k: out.boolean(k, True) for k in ("tractions", "solution", "plot")}
-    spec["outputs"]["reaction"] = _name(out, "reaction", bnames, "boundary", first)
+    spec["outputs"]["reaction"] = name_ref(out, "reaction", bnames, "boundary", first)
     out.done()
     an = top.table("analytic", None)
     spec["analytic"] = None if an is None else _analytic(an, bodies, pairs, bnames)
-    spec["checks"] = [_check(c) for c in top.tables("checks")]
+    spec["checks"] = [parse_check(c) for c in top.tables("checks")]
     top.done()
     from dolfinx_forms.app import scene_geometry
 
     scene_geometry.check(spec)  # polygons, overlaps, the grid's extent, h against the bodies
     return spec
-
-
-def plain_name(top, default_name):
-    """The description's `name`: a plain file name, the folder of its results (default: the
-    file's stem, made plain: "my scene.toml" gives "my_scene")."""
-    default_name = re.sub(r"[^A-Za-z0-9_.-]", "_", default_name)[:100].strip(".") or "scene"
-    name = top.string("name", default_name)
-    if not NAME.fullmatch(name) or name in (".", ".."):
-        raise SpecError(
-            "name", f"a plain file name (letters, digits, '-', '_', '.'; at most 100), got {name!r}"
-        )
-    return name
 
 
 # the discretization keys one kind reads and the other refuses
