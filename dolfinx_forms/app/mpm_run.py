@@ -202,6 +202,7 @@ class Steps:
             linear_solver=sim.problem.linear.name,  # the last step's
             condensed_dofs=int(getattr(sim.problem.linear, "num_dofs", 0)),
             cutbacks=int(sum(r["cutbacks"] for r in self.records)),
+            factorisations=[r["factorisations"] for r in self.records],  # per step
             warnings=[f"step {k}: {w}" for w, k in self.checks.items()],
         )
 

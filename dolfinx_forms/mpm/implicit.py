@@ -283,6 +283,8 @@ class ImplicitMPM:
             # |R| of every Newton iteration of the accepted solve (a cut-back's are dropped)
             residuals=[float(r) for s in problem.steps for r in s.residuals],
             cutbacks=int(sum(s.cutback for s in problem.steps)),
+            # sparse factorisations of the accepted solve (each step builds its own problem)
+            factorisations=int(problem.factorisations),
             num_dofs=int(imap.size_global * problem.bs),
             num_cells=int(scene.mesh.topology.index_map(2).size_global),
             points_outside_cells=outside,

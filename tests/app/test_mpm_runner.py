@@ -8,6 +8,7 @@ force target is reached within its tolerance; bad descriptions are one line, exi
 written. The tutorial's multi-step scene on 1 and 2 ranks: tests/app/test_tutorial.py."""
 
 import csv
+import json
 import os
 import subprocess
 import sys
@@ -92,6 +93,10 @@ def test_force_target_is_reached(tmp_path):
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
     fy = [float(row["platen_top_fy"]) for row in table(out / "steps.csv")]
     assert fy == pytest.approx([200.0, 400.0], abs=1e-4 * 400.0)
+    # per step: its Newton residuals and its sparse factorisations (the accepted solve's)
+    solver = json.loads((out / "metrics.json").read_text())["solver"]
+    assert len(solver["residual_history"]) == len(solver["factorisations"]) == 2
+    assert all(f >= 1 for f in solver["factorisations"])
 
 
 BASE = {
