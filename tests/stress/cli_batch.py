@@ -112,7 +112,9 @@ def run_one(mod, path, case, scratch):
     )
 
 
-def main(cases_file, results_file):
+def run_batch(cases_file, results_file, prefix, run_case):
+    """run_case(case, scratch) for every case of CASES.json, under the SIGALRM timeout, in a
+    scratch folder removed afterwards; the results to RESULTS.json (runner_batch.py too)."""
     cases = json.loads(Path(cases_file).read_text())
     results_file = Path(results_file).resolve()
 
@@ -121,28 +123,34 @@ def main(cases_file, results_file):
 
     signal.signal(signal.SIGALRM, alarm)
     home = os.getcwd()
-    scratch = tempfile.mkdtemp(prefix="cli_batch.")
-    modules = {}
+    scratch = tempfile.mkdtemp(prefix=prefix)
     results = []
     try:
         for case in cases:
-            demo = case["demo"]
-            if demo not in modules:
-                try:
-                    modules[demo] = load(demo)
-                except BaseException:
-                    modules[demo] = traceback.format_exc()
-            if isinstance(modules[demo], str):  # the demo cannot be imported
-                results.append(dict(code=1, status="import", stdout="", stderr=modules[demo]))
-                continue
-            path = ROOT / "demos" / f"{demo}.py"
-            results.append(run_one(modules[demo], path, case, scratch))
+            results.append(run_case(case, scratch))
     finally:
         os.chdir(home)
         for p in Path(scratch).iterdir():
             p.unlink()
         os.rmdir(scratch)
     Path(results_file).write_text(json.dumps(results, indent=1))
+
+
+def main(cases_file, results_file):
+    modules = {}
+
+    def run_case(case, scratch):
+        demo = case["demo"]
+        if demo not in modules:
+            try:
+                modules[demo] = load(demo)
+            except BaseException:
+                modules[demo] = traceback.format_exc()
+        if isinstance(modules[demo], str):  # the demo cannot be imported
+            return dict(code=1, status="import", stdout="", stderr=modules[demo])
+        return run_one(modules[demo], ROOT / "demos" / f"{demo}.py", case, scratch)
+
+    run_batch(cases_file, results_file, "cli_batch.", run_case)
 
 
 if __name__ == "__main__":

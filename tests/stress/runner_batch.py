@@ -11,11 +11,7 @@ Nothing here is a pytest test; tests/stress/test_hostile_multistep.py starts it.
 """
 
 import importlib.util
-import json
-import os
-import signal
 import sys
-import tempfile
 from pathlib import Path
 
 # cli_batch.py beside this file, loaded by path (no sys.path edits: tests/app/test_package.py)
@@ -30,24 +26,11 @@ def main(cases_file, results_file):
     from dolfinx_forms.app import mpm_runner
 
     mpm_runner.run = cli_batch._guard  # a description that passed: stop before computing
-    cases = json.loads(Path(cases_file).read_text())
 
-    def alarm(signum, frame):
-        raise cli_batch.Timeout()
+    def run_case(case, scratch):
+        return cli_batch.run_one(entry, "-m dolfinx_forms", case, scratch)
 
-    signal.signal(signal.SIGALRM, alarm)
-    home = os.getcwd()
-    scratch = tempfile.mkdtemp(prefix="runner_batch.")
-    results = []
-    try:
-        for case in cases:
-            results.append(cli_batch.run_one(entry, "-m dolfinx_forms", case, scratch))
-    finally:
-        os.chdir(home)
-        for p in Path(scratch).iterdir():
-            p.unlink()
-        os.rmdir(scratch)
-    Path(results_file).write_text(json.dumps(results, indent=1))
+    cli_batch.run_batch(cases_file, results_file, "runner_batch.", run_case)
 
 
 if __name__ == "__main__":
