@@ -43,10 +43,8 @@ OPTIONS = [  # option, kind, default[, help]
     ("--step-displacement", "(0, inf)", 0.02, "platen travel per step (mm)"),
     ("--steps", range(1, 10001), 50),
     ("--h", "(0, inf)", 0.2, "grid spacing (mm)"),
-    ("--eps0", cli.MPM_EPS0_INTERVAL, 0.6, "penalty factor (eq 51, eps = eps0 h / (2 E) against "
-     "the rigid platens), in [1e-4, 1] (cli.MPM_EPS0: softer, the platens pass through the "
-     "disc; stiffer, Newton fails); 0.6: the penalty's compliance stays well below the disc's "
-     "at a = 5 h"),
+    ("--eps0", cli.MPM_EPS0_INTERVAL, 0.6, "penalty factor (eq 51: eps = eps0 h / (2 E) at the "
+     "platens; cli.MPM_EPS0); 0.6: its compliance well below the disc's at a = 5 h"),
     ("--series-every", range(1, 10001), 10, "steps between frames of the time series"),
 ]
 COLUMNS = ["step", "displacement", "force_top", "force_bottom", "half_width_top",

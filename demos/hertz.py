@@ -9,13 +9,9 @@ the normal load (applied frictionless, so no tangential traction is locked in), 
 switched on and the cylinder top is moved sideways until the tangential force reaches
 Q = r mu P. Cattaneo-Mindlin: a central stick zone of half-width c = a sqrt(1 - Q/(mu P)).
 
-The check. metrics.json holds a, p0 and the relative L2 error of p(x) against Hertz *at the
-computed load* (the reaction), the stick half-width against c at the computed Q, the Newton
-residual history and the phase timings. Hertz keeps the parabola of the cylinder's gap: the
-errors against the circle itself (`_circle`, to O((a/R)^4)) are there too; they differ by up
-to 0.4 % at the default a/R = 0.1.
-
-Defaults: the fastest accurate settings per path (meshes/hertz.py path_defaults).
+The check. a, p0 and the L2 error of p(x) against Hertz at the computed load, the stick
+half-width against c at the computed Q; also against the circle itself (`_circle`: 0.4 % apart
+at a/R = 0.1). Defaults: the fastest accurate settings per path (meshes/hertz.py).
 Run: /usr/bin/python3 demos/hertz.py [--discretization cut] [--mu 0.3 --tangential 0.5]
 Results and discussion: docs/demos/hertz.md
 """
