@@ -69,8 +69,9 @@ class BulkForms:
         for t, law in self.laws.items():
             groups.setdefault(law_key(law), (law, []))[1].append(t)
         lin = [law.residual(u, v, measure(ts)) for law, ts in groups.values() if law.linear]
+        # a law whose coefficients live at quadrature points names their degree (the MPM's F_n)
         nl = [
-            law.residual(u, v, measure(ts, nonlinear=True))
+            law.residual(u, v, measure(ts, True, getattr(law, "quadrature_degree", None)))
             for law, ts in groups.values()
             if not law.linear
         ]

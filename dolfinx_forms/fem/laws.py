@@ -10,6 +10,13 @@ expression, pushed forward for finite strain). Write your own law by subclassing
 set `linear`, `modulus` (a Young's modulus scale: penalty eq 51) and `p_modulus` (the
 stiffness across a face, 2 mu + lambda for isotropy: ghost penalty) and return a UFL
 tensor from `stress` (see docs/tutorial.md).
+
+Finite strain on the material-point path (`dolfinx_forms.mpm.finite_strain`): a law with
+`finite_strain = True` gives its Kirchhoff stress from the deformation gradient,
+`kirchhoff(F, f, history)` (F = f F_n the total gradient, f = I + grad du the step's relative
+one, `history` the law's state at the step's start: a UFL vector of `history_size`), and, if it
+has a history, its value at the step's end, `history_update(F, f, history)`. A hyperelastic law
+only writes `piola(F)` (then tau = P F^T); `plasticity.J2Plasticity` carries its history.
 """
 
 from __future__ import annotations
@@ -32,10 +39,25 @@ class Law:
     """A bulk law (see the module docstring). Subclasses override `stress`."""
 
     linear = True
+    finite_strain = False  # kirchhoff(F, f, history) defined (the MPM's finite-strain path)
+    history_size = 0  # entries of the history a point carries (finite-strain path)
+    initial_history = ()  # its value in the undeformed state
     modulus = 1.0  # Young's modulus scale (penalty of eq 51)
     p_modulus = 1.0  # stiffness normal to a face (ghost penalty)
 
     def stress(self, u):
+        raise NotImplementedError
+
+    def piola(self, F):
+        """First Piola-Kirchhoff stress of a hyperelastic law as a function of F."""
+        raise NotImplementedError
+
+    def kirchhoff(self, F, f, history):
+        """Kirchhoff stress tau = P F^T (module docstring); history unused by default."""
+        return self.piola(F) * F.T
+
+    def history_update(self, F, f, history):
+        """The history at the end of a step (module docstring); none by default."""
         raise NotImplementedError
 
     def cauchy(self, u):
@@ -127,11 +149,14 @@ class NeoHookean(IsotropicLaw):
     """
 
     linear = False
+    finite_strain = True
 
-    def stress(self, u):
-        F = ufl.Identity(len(u)) + ufl.grad(u)
+    def piola(self, F):
         Finv_T = ufl.inv(F).T
         return self.mu * (F - Finv_T) + self.lmbda * ufl.ln(ufl.det(F)) * Finv_T
+
+    def stress(self, u):
+        return self.piola(ufl.Identity(len(u)) + ufl.grad(u))
 
     def cauchy(self, u):
         F = ufl.Identity(len(u)) + ufl.grad(u)

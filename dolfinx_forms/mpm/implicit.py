@@ -45,6 +45,7 @@ from dolfinx_forms.fem.boundary import Load
 from dolfinx_forms.fem.cut import grid_cells
 from dolfinx_forms.fem.laws import as_law, law_key
 from dolfinx_forms.mpm import evolution, records
+from dolfinx_forms.mpm import finite_strain as fs
 from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 
@@ -109,11 +110,18 @@ class ImplicitMPM:
             raise ValueError("ImplicitMPM: the background grid must be uniform (WENO5 advection)")
         self.bodies = list(bodies)
         self.laws = {b.tag: as_law(b.law) for b in self.bodies}
-        tangents = {}  # one per distinct law (13 bodies of one material: 0.4 s -> 0.03 s)
-        for law in self.laws.values():
-            if law_key(law) not in tangents:
-                tangents[law_key(law)] = mp.law_tangent(law)
-        self.C = {tag: tangents[law_key(law)] for tag, law in self.laws.items()}
+        # linear laws: small strain, the points' stress updated by C : d_eps (one C per distinct
+        # law: 13 bodies of one material, 0.4 s -> 0.03 s); finite-strain laws: F and history
+        # at the points (finite_strain.py), one compiled point law per distinct law
+        tangents, point_laws = {}, {}
+        for b in self.bodies:
+            law, key = self.laws[b.tag], law_key(self.laws[b.tag])
+            if law.finite_strain:
+                point_laws.setdefault(key, fs.PointLaw(law))
+            elif key not in tangents:
+                tangents[key] = mp.law_tangent(law)  # ValueError for other nonlinear laws
+        self.C = {t: tangents[law_key(w)] for t, w in self.laws.items() if not w.finite_strain}
+        self.point_laws = {t: point_laws[law_key(w)] for t, w in self.laws.items() if w.finite_strain}
         self.levelsets = {}
         for b in self.bodies:
             if isinstance(b.shape, _cpp.LevelSet):
@@ -221,12 +229,11 @@ class ImplicitMPM:
                 for body, b, box in zip(scene.bodies, self.bodies, boxes):
                     body.shape = scene.cut.levelsets[b.tag] = self.levelsets[b.tag]
                     body.bbox = box
-        sigma0 = None
-        if self.points is not None:
-            with self.phase("mls"):
-                sigma0, mls_info = self._project(scene)
-        else:
-            mls_info = {"widened": 0}
+        sigma0, laws, mls_info = None, dict(self.laws), {"widened": 0}
+        with self.phase("mls"):
+            if self.points is not None and self.C:
+                sigma0 = self._project(scene, "stress", list(self.C), 3, mls_info)
+            laws.update(self._finite_strain_laws(scene, mls_info))
         loads = []
         if sigma0 is not None:
             S = _stress_tensor(sigma0)
@@ -242,7 +249,7 @@ class ImplicitMPM:
             kw["contact_rank"] = ranks
         problem = ContactProblem(
             scene,
-            self.laws,
+            laws,
             dirichlet=self.dirichlet,
             loads=loads,
             obstacles=self.obstacles,
@@ -252,6 +259,9 @@ class ImplicitMPM:
         )
         if self.points is None:
             self.points = {b.tag: mp.seed(scene, problem.integration, b.tag) for b in self.bodies}
+            for t, pts in self.points.items():
+                h0 = np.asarray(self.laws[t].initial_history, float)
+                pts.history = np.tile(h0, (len(pts), 1))
         keys = problem.contact.names(scene)
         with self.phase("contact"):
             records.transfer_friction(self, problem, keys)
@@ -265,7 +275,10 @@ class ImplicitMPM:
             for b in self.bodies:
                 pts = self.points[b.tag]
                 du, grad, n_out = mp.displacement_at(problem, b.tag, pts.x, self.h)
-                mp.update(pts, du, grad, self.C[b.tag])
+                if b.tag in self.point_laws:
+                    mp.update_finite(pts, du, grad, self.point_laws[b.tag])
+                else:
+                    mp.update(pts, du, grad, self.C[b.tag])
                 outside += n_out
                 moved.append(du)
             if self.step_count == 0:
@@ -374,27 +387,61 @@ class ImplicitMPM:
         pairs = _cpp.candidate_pairs(self.body_boxes().reshape(len(self.bodies), 4), 0.5 * band)
         return [tuple(int(v) for v in p) for p in np.asarray(pairs).reshape(-1, 2)]
 
-    def _project(self, scene):
-        """MLS projection of each body's point stress to the Gauss points (degree mp.DEGREE) of
-        its cells: a `Quadrature` vector function [s_xx, s_yy, s_xy]."""
+    def _quadrature_function(self, scene, dim, name):
+        """A `Quadrature` vector Function of `dim` components at the Gauss points (degree
+        mp.DEGREE) of every cell, and its (cells, points) dof table."""
         mesh = scene.mesh
         Qe = ufl.VectorElement(
-            "Quadrature", mesh.ufl_cell(), mp.DEGREE, dim=3, quad_scheme="default"
+            "Quadrature", mesh.ufl_cell(), mp.DEGREE, dim=dim, quad_scheme="default"
         )
-        sigma0 = fem.Function(fem.FunctionSpace(mesh, Qe), name="sigma0")
-        qdofs = sigma0.function_space.dofmap.list.array.reshape(len(scene.cell_tags.values), -1)
-        arr = sigma0.x.array.reshape(-1, 3)
+        q = fem.Function(fem.FunctionSpace(mesh, Qe), name=name)
+        return q, q.function_space.dofmap.list.array.reshape(len(scene.cell_tags.values), -1)
+
+    def _project(self, scene, field, tags, dim, info, out=None):
+        """MLS projection of the points' `field` ((n, dim) per point) of the bodies `tags` to
+        the Gauss points of their cells: a `Quadrature` Function (`out`, or a new one)."""
+        q, qdofs = self._quadrature_function(scene, dim, field) if out is None else out
+        arr = q.x.array.reshape(-1, dim)
         widened = 0
-        for b in self.bodies:
-            cells = scene.cell_tags.indices[scene.cell_tags.values == b.tag]
+        for t in tags:
+            cells = scene.cell_tags.indices[scene.cell_tags.values == t]
             if len(cells) == 0:
                 continue
             targets = mp.quadrature_points(scene, cells).reshape(-1, 2)
-            pts = self.points[b.tag]
-            r = _cpp.MLSProjector(pts.x, self.h).project(pts.stress, np.ascontiguousarray(targets))
+            pts = self.points[t]
+            values = np.ascontiguousarray(getattr(pts, field).reshape(len(pts), dim))
+            r = _cpp.MLSProjector(pts.x, self.h).project(values, np.ascontiguousarray(targets))
             arr[qdofs[cells].ravel()] = r["values"]
             widened += int(np.sum(r["widening"] > 1))
         widened = self.comm.allreduce(widened, op=MPI.SUM)
         if widened:
             self.log(f"MLS: {widened} integration points needed a wider support (reported)")
-        return sigma0, {"widened": widened}
+        info["widened"] += widened
+        return q
+
+    def _finite_strain_laws(self, scene, info):
+        """{tag: fs.UpdatedLaw} of the finite-strain bodies: F_n and the history projected from
+        the points (identity and the initial history before the first step), one UpdatedLaw
+        per distinct law."""
+        if not self.point_laws:
+            return {}
+        Fq, qd = self._quadrature_function(scene, 4, "F_n")
+        Fq.x.array.reshape(-1, 4)[:] = np.eye(2).ravel()
+        if self.points is not None:
+            self._project(scene, "F", list(self.point_laws), 4, info, (Fq, qd))
+        out, shared = {}, {}
+        for t in self.point_laws:
+            law = self.laws[t]
+            key = law_key(law)
+            if key not in shared:
+                tags = [s for s in self.point_laws if law_key(self.laws[s]) == key]
+                hq = None
+                if law.history_size:
+                    k = law.history_size
+                    hq, hd = self._quadrature_function(scene, k, "history")
+                    hq.x.array.reshape(-1, k)[:] = np.asarray(law.initial_history, float)
+                    if self.points is not None:
+                        self._project(scene, "history", tags, k, info, (hq, hd))
+                shared[key] = fs.UpdatedLaw(law, Fq, hq, mp.DEGREE)
+            out[t] = shared[key]
+        return out

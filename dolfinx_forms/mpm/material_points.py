@@ -47,13 +47,22 @@ class MaterialPoints:
     vol0: np.ndarray  # (n,)
     vol: np.ndarray  # (n,)
     stress: np.ndarray  # (n, 3) Cauchy [xx, yy, xy]
+    F: np.ndarray = None  # (n, 2, 2) deformation gradient (identity when seeded)
+    history: np.ndarray = None  # (n, k) the law's history (finite_strain.py)
+
+    def __post_init__(self):
+        if self.F is None:
+            self.F = np.tile(np.eye(2), (len(self.vol0), 1, 1))
+        if self.history is None:
+            self.history = np.zeros((len(self.vol0), 0))
 
     def __len__(self):
         return len(self.vol0)
 
     def copy(self):
         return MaterialPoints(
-            self.tag, self.x.copy(), self.vol0.copy(), self.vol.copy(), self.stress.copy()
+            self.tag,
+            *(a.copy() for a in (self.x, self.vol0, self.vol, self.stress, self.F, self.history)),
         )
 
 
@@ -194,12 +203,28 @@ def q1_basis(X):
 
 
 def update(points, du, grad, C):
-    """Move the points by du and update stress and volume (module docstring); in place."""
+    """Move the points by du and update stress, F and volume (module docstring); in place."""
     e = np.stack([grad[:, 0, 0], grad[:, 1, 1], grad[:, 0, 1] + grad[:, 1, 0]], axis=1)
     s = points.stress
     w = 0.5 * (grad[:, 0, 1] - grad[:, 1, 0])  # dW = [[0, w], [-w, 0]]
     rot = np.stack([2 * w * s[:, 2], -2 * w * s[:, 2], w * (s[:, 1] - s[:, 0])], axis=1)
     points.stress = s + e @ C.T + rot
     points.x = points.x + du
-    F = np.eye(2)[None] + grad
-    points.vol = points.vol * (F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0])
+    f = np.eye(2)[None] + grad
+    points.F = f @ points.F
+    points.vol = points.vol * det2(f)
+
+
+def update_finite(points, du, grad, point_law):
+    """Finite strain (finite_strain.py): F <- f F_n, stress and history from the law at F,
+    vol = vol0 det F; in place."""
+    f = np.eye(2)[None] + grad
+    points.stress, points.history = point_law(points.F, f, points.history)
+    points.F = f @ points.F
+    points.x = points.x + du
+    points.vol = points.vol0 * det2(points.F)
+
+
+def det2(F):
+    """det of (n, 2, 2) matrices (closed form)."""
+    return F[:, 0, 0] * F[:, 1, 1] - F[:, 0, 1] * F[:, 1, 0]
