@@ -210,3 +210,69 @@ def plate_forces(record):
         force_bottom=-f["plate_bottom"][1],
         force_top=f["plate_top"][1],
     )
+
+
+def block_between_platens(comm, width=2.0, height=2.0, h=0.1, compression=0.4, steps=20):
+    """A width x height block centred at the origin between two frictionless rigid half-plane
+    platens wider than it, the lower fixed (y < -height/2), the upper (y > height/2) moved down
+    by compression x height / steps per step. Returns (grid lines, (name, tag, shape),
+    obstacles, build_scene). The grid has lines at x = 0 (the u_x = 0 symmetry condition) and
+    y = 0 (the mid-height width) and room for a lateral stretch of 2.5."""
+    W, H = float(width), float(height)
+    d = compression * H / steps
+    xl = uniform_lines(-1.25 * W - 3 * h, 1.25 * W + 3 * h, h)
+    yl = uniform_lines(-0.5 * H - 3 * h, 0.5 * H + 3 * h, h)
+    ext, X = 100 * max(W, H), xl[-1] - xl[0]
+    top = RigidObstacle(
+        "platen_top",
+        half_plane((0.0, 0.5 * H), (0.0, -1.0), ext),
+        bbox=[[-X, 0.5 * H], [X, H]],
+        center=(0.0, 0.5 * H),
+        translation=(0.0, -d),
+    )
+    bottom = RigidObstacle(
+        "platen_bottom",
+        half_plane((0.0, -0.5 * H), (0.0, 1.0), ext),
+        bbox=[[-X, -H], [X, -0.5 * H]],
+        center=(0.0, -0.5 * H),
+    )
+    box = np.array([[[xl[0], yl[0]], [xl[-1], yl[-1]]]])  # one rank computes both contacts
+    build = grid_scene(comm, xl, yl, [("block", 1)], contact_box=box)
+    shape = df.Box([-0.5 * W, -0.5 * H], [0.5 * W, 0.5 * H])
+    return (xl, yl), ("block", 1, shape), [top, bottom], build
+
+
+def check_block(width, height, h, compression, steps):
+    """ValueError (its message names the option) unless the grid has 8 to 2000 cells across
+    the block's smaller side and one step moves the platen by at most h."""
+    side = min(width, height)
+    if not side / 2000 <= h <= side / 8:
+        raise ValueError(
+            f"--h: must be in [{side / 2000:g}, {side / 8:g}] (8 to 2000 cells across the "
+            f"block's smaller side), got {h}"
+        )
+    if not compression * height / steps <= h * (1 + 1e-12):
+        raise ValueError(
+            f"--steps: the platen must move at most h per step (contact band and level-set "
+            f"advection): need steps >= {int(np.ceil(compression * height / h - 1e-9))}, "
+            f"got {steps}"
+        )
+
+
+def width_at(levelset, xlines, ylines, y):
+    """The extent of the zero contour of a grid level set along the grid line through y
+    (outermost sign changes, linear between nodes)."""
+    j = int(np.argmin(np.abs(np.asarray(ylines) - y)))
+    phi = np.asarray(levelset.values).reshape(len(ylines), len(xlines))[j]
+    inside = np.flatnonzero(phi <= 0)
+    if len(inside) == 0:
+        return 0.0
+    i0, i1 = inside[0], inside[-1]
+    xl = np.asarray(xlines)
+    left = xl[i0] if i0 == 0 else xl[i0 - 1] + (xl[i0] - xl[i0 - 1]) * phi[i0 - 1] / (
+        phi[i0 - 1] - phi[i0]
+    )
+    right = xl[i1] if i1 == len(xl) - 1 else xl[i1] + (xl[i1 + 1] - xl[i1]) * phi[i1] / (
+        phi[i1] - phi[i1 + 1]
+    )
+    return float(right - left)

@@ -55,6 +55,30 @@ def brazilian_disc_plots(run, folder, half_width):
     _save(plt, fig, folder / "sigma_yy.png", tight=False)
 
 
+def block_plots(run, folder, reference):
+    """demos/block_compression.py: force.png (force per unit thickness against compression,
+    with the homogeneous solution reference(params, l_y) -> (force, l_x)) and F_yy.png (F_yy at
+    the material points at the end: uniform in the exact solution)."""
+    plt = _pyplot()
+    p, rows = run.params, run.rows
+    c = np.array([r["compression"] for r in rows])
+    cs = np.linspace(0, c.max(), 100)[1:]
+    fig, ax = plt.subplots(figsize=(5, 4))
+    ax.plot(cs, reference(p, 1 - cs)[0] if p["law"] != "linear" else np.interp(
+        cs, c, reference(p, 1 - c)[0]), "k-", label="homogeneous")  # fmt: skip
+    ax.plot(c, [r["force"] for r in rows], "o", ms=3, label="MPM, top platen")
+    ax.set(xlabel="compression", ylabel="F (N/mm)", title=f"Block ({p['law']})")
+    ax.legend()
+    _save(plt, fig, folder / "force.png")
+    pts = run.sim.points[1]
+    fig, ax = plt.subplots(figsize=(5, 4))
+    image, extent = binned_mean(pts.x, pts.F[:, 1, 1], p["h"])
+    sc = ax.imshow(image, extent=extent, origin="lower", cmap="viridis")
+    ax.set(aspect="equal", title=f"F_yy at the points, step {len(rows)}")
+    fig.colorbar(sc, ax=ax)
+    _save(plt, fig, folder / "F_yy.png")
+
+
 def max_principal(s):
     """Largest principal stress of [s_xx, s_yy, s_xy] rows."""
     return 0.5 * (s[:, 0] + s[:, 1]) + np.hypot(0.5 * (s[:, 0] - s[:, 1]), s[:, 2])

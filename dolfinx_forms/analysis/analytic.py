@@ -94,3 +94,75 @@ def inclined_uniaxial_state(E, nu, d, height, slope, eps_n=0.0, eps_t=0.0):
     g1 = eps_n * tau_n * n + eps_t * tau_t * t
     s = d / ((1 - nu**2) * height / E - g1[1])
     return dict(s=s, exx=nu * (1 + nu) * s / E, gx=s * g1[0], p_n=-s * tau_n, tau_t=s * tau_t)
+
+
+# ---------------------------------------------------------------- homogeneous plane-strain block
+# A block between frictionless platens: F = diag(l_x, l_y, 1), l_y prescribed, l_x from a free
+# lateral face (sigma_xx = 0). Each returns the compressive force per unit thickness on the
+# platen, |sigma_yy| times the current width (= |P_yy| times the initial one), and l_x.
+
+
+def _free_stretch(tau_xx, lx0):
+    """l_x with tau_xx(l_x) = 0 by the secant method from l_x0 (to round-off)."""
+    a, b = lx0, lx0 * (1 + 1e-3)
+    fa, fb = tau_xx(a), tau_xx(b)
+    for _ in range(100):
+        if fb == fa:
+            break
+        a, b, fa = b, b - fb * (b - a) / (fb - fa), fb
+        fb = tau_xx(b)
+        if abs(b - a) <= 1e-15 * abs(b):
+            break
+    return b
+
+
+def block_neo_hookean(ly, width, mu, lmbda):
+    """Compressible neo-Hookean (laws.NeoHookean): P = mu (F - F^-T) + lambda ln J F^-T.
+    ly: an array of stretches; returns (force, l_x) arrays."""
+    out = []
+    for y in np.atleast_1d(ly):
+        lx = _free_stretch(lambda x: mu * (x - 1 / x) + lmbda * np.log(x * y) / x, 1.0)
+        out.append((abs(mu * (y - 1 / y) + lmbda * np.log(lx * y) / y) * width, lx))
+    return tuple(np.array(v) for v in zip(*out))
+
+
+def block_hypoelastic(ly, width, E, nu):
+    """The small-strain MPM update (sigma += C : d_eps per step, d_eps on the step's
+    configuration; no spin in pure stretch) integrated along the steps l_y[0], l_y[1], ...
+    (from 1): sigma_xx = 0 gives d_eps_x = -C12 / C11 d_eps_y."""
+    mu, lmbda = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
+    C11, C12 = 2 * mu + lmbda, lmbda
+    syy, lx, y0, out = 0.0, 1.0, 1.0, []
+    for y in np.atleast_1d(ly):
+        dy = (y - y0) / y0
+        dx = -C12 / C11 * dy
+        syy += C12 * dx + C11 * dy
+        lx, y0 = lx * (1 + dx), y
+        out.append((abs(syy) * width * lx, lx))
+    return tuple(np.array(v) for v in zip(*out))
+
+
+def block_j2(ly, width, E, nu, yield_stress, hardening):
+    """Finite-strain J2 (plasticity.J2Plasticity: logarithmic elastic strain, Kirchhoff
+    stress, radial return) integrated along the steps l_y[0], l_y[1], ... from the virgin
+    state, in principal axes x, y, z (the block's never rotate); each step's l_x from
+    tau_xx = 0. An independent principal-space implementation. Returns (force, l_x, alpha)."""
+    G, lmbda = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
+    K = lmbda + 2 * G / 3
+    be, alpha, lx0, y0, out = np.ones(3), 0.0, 1.0, 1.0, []
+
+    def update(f):
+        eps = 0.5 * np.log(f**2 * be)
+        dev = eps - eps.sum() / 3
+        q = np.sqrt(1.5) * 2 * G * np.linalg.norm(dev)
+        phi = q - (yield_stress + hardening * alpha)
+        dg = max(phi, 0.0) / (3 * G + hardening)
+        e = eps.sum() / 3 + (1 - 3 * G * dg / q if phi > 0 else 1.0) * dev
+        return K * e.sum() + 2 * G * (e - e.sum() / 3), e, dg
+
+    for y in np.atleast_1d(ly):
+        lx = _free_stretch(lambda x: update(np.array([x / lx0, y / y0, 1.0]))[0][0], lx0)
+        tau, e, dg = update(np.array([lx / lx0, y / y0, 1.0]))
+        be, alpha, lx0, y0 = np.exp(2 * e), alpha + dg, lx, y
+        out.append((abs(tau[1]) / y * width, lx, alpha))
+    return tuple(np.array(v) for v in zip(*out))

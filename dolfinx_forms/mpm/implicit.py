@@ -397,9 +397,13 @@ class ImplicitMPM:
         q = fem.Function(fem.FunctionSpace(mesh, Qe), name=name)
         return q, q.function_space.dofmap.list.array.reshape(len(scene.cell_tags.values), -1)
 
-    def _project(self, scene, field, tags, dim, info, out=None):
+    def _project(self, scene, field, tags, dim, info, out=None, inside=False):
         """MLS projection of the points' `field` ((n, dim) per point) of the bodies `tags` to
-        the Gauss points of their cells: a `Quadrature` Function (`out`, or a new one)."""
+        the Gauss points of their cells: a `Quadrature` Function (`out`, or a new one).
+        inside: Gauss points of cut cells outside the body take the value at their closest
+        point on the contour (x - phi grad phi / |grad phi|), not the MLS extrapolation beyond
+        the points: the finite-strain fields enter ln det F and the law's logarithms, which an
+        extrapolated F or b_e with det <= 0 would make NaN."""
         q, qdofs = self._quadrature_function(scene, dim, field) if out is None else out
         arr = q.x.array.reshape(-1, dim)
         widened = 0
@@ -408,6 +412,11 @@ class ImplicitMPM:
             if len(cells) == 0:
                 continue
             targets = mp.quadrature_points(scene, cells).reshape(-1, 2)
+            if inside:
+                phi, grad = self.levelsets[t].evaluate(targets)
+                out_ = phi > 0
+                g = grad[out_] / np.linalg.norm(grad[out_], axis=1)[:, None]
+                targets[out_] -= phi[out_, None] * g
             pts = self.points[t]
             values = np.ascontiguousarray(getattr(pts, field).reshape(len(pts), dim))
             r = _cpp.MLSProjector(pts.x, self.h).project(values, np.ascontiguousarray(targets))
@@ -428,7 +437,7 @@ class ImplicitMPM:
         Fq, qd = self._quadrature_function(scene, 4, "F_n")
         Fq.x.array.reshape(-1, 4)[:] = np.eye(2).ravel()
         if self.points is not None:
-            self._project(scene, "F", list(self.point_laws), 4, info, (Fq, qd))
+            self._project(scene, "F", list(self.point_laws), 4, info, (Fq, qd), True)
         out, shared = {}, {}
         for t in self.point_laws:
             law = self.laws[t]
@@ -441,7 +450,7 @@ class ImplicitMPM:
                     hq, hd = self._quadrature_function(scene, k, "history")
                     hq.x.array.reshape(-1, k)[:] = np.asarray(law.initial_history, float)
                     if self.points is not None:
-                        self._project(scene, "history", tags, k, info, (hq, hd))
+                        self._project(scene, "history", tags, k, info, (hq, hd), True)
                 shared[key] = fs.UpdatedLaw(law, Fq, hq, mp.DEGREE)
             out[t] = shared[key]
         return out

@@ -1,0 +1,167 @@
+#!/usr/bin/python3
+"""A block compressed between frictionless rigid platens at finite strain: the implicit MPM.
+
+Physics. A width x height block (plane strain) between two frictionless rigid platens wider
+than it, the lower fixed, the upper moved down in --steps equal steps to --compression of the
+height. The law: `linear` (small strain: the points' stress updated by C : d_eps), `neo-hookean`
+or `j2` (finite strain: F and the law's history at the material points, an updated-Lagrangian
+step on the current configuration; j2 is Hencky elasticity with von Mises plasticity and
+linear isotropic hardening, dolfinx_forms/fem/plasticity.py). u_x = 0 on x = 0 (symmetry) holds
+the block's only rigid motion the platens leave free.
+
+The check. The deformation is homogeneous, F = diag(l_x, l_y) with l_y = 1 - compression and
+l_x from the free sides (sigma_xx = 0): the force per unit thickness on the top platen against
+|P_yy| times the initial width (neo-Hookean: closed form; j2: the return mapping integrated
+along the steps; linear: the small-strain update integrated along the steps), the width at
+mid-height against l_x times the width, the level-set area against the points' volume (both
+det F times the initial area), and the mass of the points.
+
+Run: /usr/bin/python3 demos/block_compression.py [--law neo-hookean] [--compression 0.4]
+Results and discussion: docs/demos/block_compression.md
+"""
+
+import importlib.util
+import sys
+
+import numpy as np
+
+if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNotFoundError
+    sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
+             "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
+from dolfinx_forms.analysis import analytic
+from dolfinx_forms.app import cli
+from dolfinx_forms.app.demo import Run
+from dolfinx_forms.app.mpm_run import Steps
+from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.fem.laws import LinearElastic, NeoHookean
+from dolfinx_forms.fem.plasticity import J2Plasticity
+from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
+from meshes.mpm import block_between_platens, check_block, width_at
+from meshes.plots import block_plots
+
+# fmt: off
+OPTIONS = [  # option, kind, default[, help]
+    ("--width", "(0, 1e6]", 2.0, "block width (mm)"),
+    ("--height", "(0, 1e6]", 2.0, "block height (mm)"),
+    ("--compression", "(0, 0.5]", 0.3, "platen travel as a fraction of the height"),
+    ("--law", ["neo-hookean", "linear", "j2"], "neo-hookean", "bulk law"),
+    ("--E", "[1e-3, 1e7]", 1000.0, "Young's modulus (N/mm^2)"),
+    ("--nu", "(-1, 0.5)", 0.3),
+    ("--yield-stress", "(0, inf)", 50.0, "j2: initial yield stress (N/mm^2)"),
+    ("--hardening", "[0, inf)", 100.0, "j2: linear isotropic hardening modulus (N/mm^2)"),
+    ("--steps", range(1, 10001), 20),
+    ("--h", "(0, inf)", 0.05, "grid spacing (mm)"),
+    ("--eps0", cli.MPM_EPS0_INTERVAL, 0.1, "penalty factor (eq 51: eps = eps0 h / (2 E)); "
+     "0.1: penetration about 1e-4 of the height, no checkerboard"),
+    ("--series-every", range(1, 10001), 5, "steps between frames of the time series"),
+]
+COLUMNS = ["step", "compression", "force", "width", "area_levelset", "volume_points"]
+TOLERANCE = 0.02  # force and width against the homogeneous solution (docs/demos)
+# fmt: on
+
+
+def parse(argv):
+    p = cli.demo_parser("block_compression.py", __doc__, "results/block_compression", OPTIONS,
+                        discretization=False, enforcement=cli.MPM_ENFORCEMENT)  # fmt: skip
+    a = p.parse_args(argv)
+    try:
+        check_block(a.width, a.height, a.h, a.compression, a.steps)
+    except ValueError as e:
+        p.error(str(e))
+    return a
+
+
+def make_law(p):
+    if p["law"] == "linear":
+        return LinearElastic(p["E"], p["nu"])
+    if p["law"] == "neo-hookean":
+        return NeoHookean(p["E"], p["nu"])
+    return J2Plasticity(p["E"], p["nu"], p["yield_stress"], p["hardening"])
+
+
+def reference(p, ly):
+    """(force, l_x) of the homogeneous block at the stretches ly (module docstring)."""
+    W, law = p["width"], make_law(p)
+    if p["law"] == "neo-hookean":
+        return analytic.block_neo_hookean(ly, W, law.mu, law.lmbda)
+    if p["law"] == "linear":
+        return analytic.block_hypoelastic(ly, W, p["E"], p["nu"])
+    return analytic.block_j2(ly, W, p["E"], p["nu"], p["yield_stress"], p["hardening"])[:2]
+
+
+def evaluate(run):
+    """Force and width against the homogeneous solution; area, volume, mass."""
+    p, rows, recs = run.params, run.rows, run.records
+    c, F, w = (np.array([r[k] for r in rows]) for k in ("compression", "force", "width"))
+    F_ref, lx = reference(p, 1 - c)
+    err_F, err_w = np.abs(F / F_ref - 1), np.abs(w / (lx * p["width"]) - 1)
+    area, vol = (np.array([r[k] for r in rows]) for k in ("area_levelset", "volume_points"))
+    pts = run.sim.points[1]
+    run.results.update(
+        force=F.tolist(), width=w.tolist(), force_rel_error_max=float(err_F.max()),
+        width_rel_error_max=float(err_w.max()),
+        area_vs_points_rel_max=float(np.max(np.abs(area / vol - 1))),
+        mass_rel_change=float(abs(recs[-1]["mass"]["block"] / recs[0]["mass"]["block"] - 1)),
+        F_yy_points=[float(pts.F[:, 1, 1].min()), float(pts.F[:, 1, 1].max())],
+        newton_iterations=[r["newton_iterations"] for r in recs],
+        newton_iterations_mean=float(np.mean([r["newton_iterations"] for r in recs])),
+        points_outside_cells_max=int(max(r["points_outside_cells"] for r in recs)),
+    )  # fmt: skip
+    run.analytic.update(force=F_ref.tolist(), width=(lx * p["width"]).tolist())
+    warn = run.metrics["solver"]["warnings"]
+    for name, e in (("force", err_F), ("width", err_w)):
+        if e.max() > TOLERANCE:
+            warn.append(f"{name} differs from the homogeneous solution by {e.max():.2%} "
+                        f"(> {TOLERANCE:.0%}) at step {int(np.argmax(e)) + 1}")  # fmt: skip
+    if run.results["area_vs_points_rel_max"] > 0.01:
+        warn.append("level-set area and point volume differ by "
+                    f"{run.results['area_vs_points_rel_max']:.1%} (> 1 %)")  # fmt: skip
+
+
+def summary(run):
+    r = run.results
+    return (
+        f"Block ({run.params['law']}): {len(run.rows)} steps to {run.rows[-1]['compression']:.3g}"
+        f" compression, F = {r['force'][-1]:.6g} N/mm (homogeneous {run.analytic['force'][-1]:.6g}"
+        f"), max force error {r['force_rel_error_max']:.2e}, width {r['width_rel_error_max']:.2e}"
+        f", area vs points {r['area_vs_points_rel_max']:.1e}, Newton "
+        f"{r['newton_iterations_mean']:.1f} per step"
+    )
+
+
+def main(argv=None):
+    args = parse(sys.argv[1:] if argv is None else argv)
+    with Run("block_compression", vars(args), discretization="cut", plot=False) as run:
+        # the scene: the block's level set and points between the two platens
+        scene_args = (args.width, args.height, args.h, args.compression, args.steps)
+        grid, (name, tag, shape), platens, scene = block_between_platens(run.comm, *scene_args)
+        # the problem: frictionless platens, u_x = 0 on x = 0
+        symmetry = Dirichlet(lambda x: np.isclose(x[0], 0.0, atol=1e-9 * args.width), 0, 0.0)
+        body = MPMBody(name, tag, make_law(vars(args)), shape)
+        kw = dict(obstacles=platens, dirichlet=[symmetry], timer=run.timer, mu=0.0)
+        sim = ImplicitMPM(run.comm, grid, [body], scene, **kw, **run.problem_options)
+
+        # the run: the upper platen moves down by compression x height / steps per step
+        steps = Steps(run, sim, COLUMNS, args.steps, args.series_every)
+        for _ in range(args.steps):
+            rec = steps.step()
+            k = rec["step"]
+            steps.rows.append(dict(
+                step=k, compression=k * args.compression / args.steps,
+                force=rec["obstacles"]["platen_top"]["fy"],
+                width=width_at(sim.levelsets[tag], *grid, 0.0),
+                area_levelset=rec["area_levelset"]["block"],
+                volume_points=rec["volume_points"]["block"],
+            ))  # fmt: skip
+        steps.measure()
+
+        # the check (rank 0): force and width against the homogeneous solution
+        if run.rank0:
+            evaluate(run)
+        run.finish(summary, **steps.outputs(lambda run, folder: block_plots(run, folder,
+                                                                             reference)))
+    return run.status
+
+
+if __name__ == "__main__":
+    cli.exit_process(main())

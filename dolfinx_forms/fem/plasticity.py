@@ -1,0 +1,118 @@
+"""J2 plasticity at finite strain with linear isotropic hardening, in UFL (plane strain).
+
+Multiplicative split F = F_e F_p; the history is the elastic left Cauchy-Green tensor
+b_e = F_e F_e^T at the step's start (its in-plane block and b_e,zz: plane strain keeps F_33 = 1
+but b_e,zz evolves with plastic flow) and the equivalent plastic strain alpha. A step with the
+relative gradient f (F = f F_n):
+
+    trial:   b_e^tr = f b_e,n f^T,   eps^tr = 1/2 ln b_e^tr   (logarithmic elastic strain)
+             tau^tr = K tr(eps^tr) I + 2 G dev(eps^tr),   q^tr = sqrt(3/2) |dev tau^tr|
+    return:  phi = q^tr - (sigma_y + H alpha_n);  if phi > 0: dgamma = phi / (3 G + H),
+             dev tau = (1 - 3 G dgamma / q^tr) dev tau^tr   (radial return)
+    update:  eps_e = tr(eps^tr)/3 I + (1 - 3 G dgamma / q^tr) dev(eps^tr),
+             b_e = exp(2 eps_e),  alpha = alpha_n + dgamma
+
+(Simo's exponential-map algorithm: the small-strain radial return in logarithmic strain, so
+any small-strain return mapping plugs in at `return_map`). The Kirchhoff stress is an explicit
+UFL expression of f and the history, so `ufl.derivative` gives the consistent (algorithmic)
+tangent. The tensors are 3 x 3 (the in-plane block and zz); the closed-form logarithm and
+exponential of the in-plane block (`log_sym2`, `exp_sym2`) are the one 2D-specific part: 3D
+needs their 3 x 3 spectral forms.
+"""
+
+from __future__ import annotations
+
+import ufl
+
+from dolfinx_forms.fem.laws import IsotropicLaw
+
+
+def log_sym2(B):
+    """ln B of a symmetric positive definite 2 x 2 B: 1/2 ln det B I + c (B - tr B / 2 I),
+    c = atanh(s) / (s m), s = sqrt(d2) / m (m = tr B / 2, d2 the squared half eigenvalue gap).
+    atanh(s) / s is even in s: a series where s^2 < 1e-3 (error < 1e-16) keeps the tangent
+    finite at equal eigenvalues."""
+    m = 0.5 * ufl.tr(B)
+    dev = B - m * ufl.Identity(2)
+    s2 = (0.25 * (B[0, 0] - B[1, 1]) ** 2 + B[0, 1] ** 2) / m**2
+    series = 1 + s2 / 3 + s2**2 / 5 + s2**3 / 7 + s2**4 / 9
+    s = ufl.sqrt(ufl.max_value(s2, 1e-3))
+    exact = 0.5 * ufl.ln((1 + s) / (1 - s)) / s
+    c = ufl.conditional(ufl.lt(s2, 1e-3), series, exact) / m
+    return 0.5 * ufl.ln(ufl.det(B)) * ufl.Identity(2) + c * dev
+
+
+def exp_sym2(A):
+    """exp A of a symmetric 2 x 2 A: e^m (cosh d I + sinh(d) / d (A - m I)), m = tr A / 2,
+    d the half eigenvalue gap (sinh(d) / d by its series where d^2 < 1e-3)."""
+    m = 0.5 * ufl.tr(A)
+    dev = A - m * ufl.Identity(2)
+    d2 = 0.25 * (A[0, 0] - A[1, 1]) ** 2 + A[0, 1] ** 2
+    d = ufl.sqrt(ufl.max_value(d2, 1e-3))
+    sinhc = ufl.conditional(
+        ufl.lt(d2, 1e-3), 1 + d2 / 6 + d2**2 / 120 + d2**3 / 5040 + d2**4 / 362880, ufl.sinh(d) / d
+    )
+    cosh = ufl.conditional(
+        ufl.lt(d2, 1e-3), 1 + d2 / 2 + d2**2 / 24 + d2**3 / 720 + d2**4 / 40320, ufl.cosh(d)
+    )
+    return ufl.exp(m) * (cosh * ufl.Identity(2) + sinhc * dev)
+
+
+def _embed(A2, zz):
+    """The 3 x 3 block-diagonal tensor of an in-plane block and a zz entry."""
+    return ufl.as_matrix(
+        [[A2[0, 0], A2[0, 1], 0], [A2[1, 0], A2[1, 1], 0], [0, 0, zz]]
+    )
+
+
+class J2Plasticity(IsotropicLaw):
+    """Finite-strain J2 plasticity with linear isotropic hardening (module docstring):
+    E, nu (the Hencky elastic law), yield_stress sigma_y > 0, hardening H >= 0. History
+    [b_xx, b_yy, b_xy, b_zz, alpha] (5 entries), initially [1, 1, 0, 1, 0]."""
+
+    linear = False
+    finite_strain = True
+    history_size = 5
+    initial_history = (1.0, 1.0, 0.0, 1.0, 0.0)
+
+    def __init__(self, E, nu, yield_stress, hardening=0.0):
+        super().__init__(E, nu)
+        if not (yield_stress > 0 and hardening >= 0):
+            raise ValueError(
+                "J2Plasticity: need yield_stress > 0 and hardening >= 0, got "
+                f"yield_stress={yield_stress}, hardening={hardening}"
+            )
+        self.yield_stress, self.hardening = float(yield_stress), float(hardening)
+        self.K = self.lmbda + 2 * self.mu / 3
+
+    def trial(self, f, h):
+        """Trial logarithmic elastic strain (3 x 3) of the step."""
+        be = ufl.as_matrix([[h[0], h[2]], [h[2], h[1]]])
+        return _embed(0.5 * log_sym2(f * be * f.T), 0.5 * ufl.ln(h[3]))
+
+    def return_map(self, eps, alpha):
+        """Radial return in logarithmic strain: (elastic strain, dgamma). A small-strain
+        return mapping of another law replaces this function."""
+        G, K, H = self.mu, self.K, self.hardening
+        e = ufl.dev(eps)
+        q = ufl.sqrt(1.5 * ufl.inner(2 * G * e, 2 * G * e))
+        phi = q - (self.yield_stress + H * alpha)
+        dgamma = ufl.max_value(phi, 0.0) / (3 * G + H)
+        scale = ufl.conditional(ufl.gt(phi, 0.0), 1 - 3 * G * dgamma / ufl.max_value(q, 1e-300), 1.0)
+        return ufl.tr(eps) / 3 * ufl.Identity(3) + scale * e, dgamma
+
+    def tau3(self, f, h):
+        eps_e, dgamma = self.return_map(self.trial(f, h), h[4])
+        tau = self.K * ufl.tr(eps_e) * ufl.Identity(3) + 2 * self.mu * ufl.dev(eps_e)
+        return tau, eps_e, dgamma
+
+    def kirchhoff(self, F, f, history):
+        tau, _, _ = self.tau3(f, history)
+        return ufl.as_matrix([[tau[0, 0], tau[0, 1]], [tau[1, 0], tau[1, 1]]])
+
+    def history_update(self, F, f, history):
+        _, eps_e, dgamma = self.tau3(f, history)
+        be = exp_sym2(2 * ufl.as_matrix([[eps_e[0, 0], eps_e[0, 1]], [eps_e[1, 0], eps_e[1, 1]]]))
+        return ufl.as_vector(
+            [be[0, 0], be[1, 1], be[0, 1], ufl.exp(2 * eps_e[2, 2]), history[4] + dgamma]
+        )
