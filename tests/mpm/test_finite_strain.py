@@ -1,0 +1,145 @@
+"""Finite strain on the material-point path (dolfinx_forms.mpm.finite_strain, fem.plasticity):
+the multiplicative point update is objective, the UFL J2 return mapping equals an independent
+principal-space implementation on the homogeneous path, its tangent is the consistent one
+(central differences of the residual), and neo-Hookean under a tiny load is the linear path."""
+
+import numpy as np
+import pytest
+import ufl
+import dolfinx.fem.petsc  # noqa: F401  (fem.petsc)
+from dolfinx import fem, mesh as dmesh
+from mpi4py import MPI
+
+from dolfinx_forms.analysis import analytic
+from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.fem.laws import LinearElastic, NeoHookean
+from dolfinx_forms.fem.plasticity import J2Plasticity
+from dolfinx_forms.mpm import material_points as mp
+from dolfinx_forms.mpm.finite_strain import PointLaw, UpdatedLaw
+from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
+import dolfinx_forms as df
+from meshes.mpm import grid_scene, uniform_lines
+
+E, NU = 1000.0, 0.3
+J2 = dict(yield_stress=50.0, hardening=100.0)
+
+
+def points(law, n=7):
+    """n points with distinct prestrains (F0) and the law's initial history."""
+    t = np.linspace(0, 1, n)
+    F = np.stack([np.stack([1.2 - 0.3 * t, 0.1 * t], 1), np.stack([-0.05 * t, 0.8 + 0.2 * t], 1)], 1)
+    x, v = np.zeros((n, 2)), np.ones(n)
+    pts = mp.MaterialPoints(1, x, v.copy(), v.copy(), np.zeros((n, 3)))
+    pts.history = np.tile(np.asarray(law.initial_history, float), (n, 1))
+    return pts, F
+
+
+def invariants(s):
+    """trace, determinant and the largest principal value of Voigt [xx, yy, xy] rows."""
+    tr, det = s[:, 0] + s[:, 1], s[:, 0] * s[:, 1] - s[:, 2] ** 2
+    return np.stack([tr, det, 0.5 * tr + np.sqrt(0.25 * (s[:, 0] - s[:, 1]) ** 2 + s[:, 2] ** 2)])
+
+
+@pytest.mark.parametrize("law", [NeoHookean(E, NU), J2Plasticity(E, NU, **J2)], ids=["nh", "j2"])
+def test_rigid_rotation_by_90_degrees_keeps_invariants_and_volumes(law):
+    """Deform (plastically for J2), then rotate rigidly by 90 degrees in 20 steps: F <- R F,
+    so every invariant of the stress, the history and the volume stay (round-off)."""
+    pl = PointLaw(law)
+    pts, F0 = points(law)
+    grad = F0 - np.eye(2)  # one step from the undeformed state to F0
+    mp.update_finite(pts, np.zeros((len(pts), 2)), grad, pl)
+    if law.history_size:
+        assert pts.history[:, 4].max() > 0.05  # the prestrain is plastic
+    s0, h0, v0 = pts.stress.copy(), pts.history.copy(), pts.vol.copy()
+    a = np.pi / 40
+    R = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
+    for _ in range(20):
+        mp.update_finite(pts, np.zeros((len(pts), 2)), np.tile(R - np.eye(2), (len(pts), 1, 1)), pl)
+    scale = np.abs(s0).max()
+    assert np.allclose(invariants(pts.stress)[[0, 2]], invariants(s0)[[0, 2]], rtol=0, atol=1e-10 * scale)
+    assert np.allclose(invariants(pts.stress)[1], invariants(s0)[1], rtol=0, atol=1e-10 * scale**2)
+    # a quarter turn: sigma_xx <-> sigma_yy, sigma_xy -> -sigma_xy
+    assert np.allclose(pts.stress, s0[:, [1, 0, 2]] * [1, 1, -1], rtol=0, atol=1e-10 * scale)
+    assert np.allclose(pts.vol, v0, rtol=1e-14, atol=0)
+    if law.history_size:
+        assert np.allclose(pts.history[:, 4], h0[:, 4], rtol=0, atol=1e-12)  # no plastic flow
+
+
+def test_j2_return_mapping_equals_the_principal_space_reference():
+    """The UFL law along the homogeneous block path (F = diag(l_x, l_y), l_x from the free side)
+    against analytic.block_j2, an independent principal-space implementation: stresses and
+    plastic strain to 1e-10 through elastic loading, yield and hardening."""
+    ly = 1 - np.linspace(0.02, 0.4, 20)
+    force, lx, alpha = analytic.block_j2(ly, 2.0, E, NU, **J2)
+    law = J2Plasticity(E, NU, **J2)
+    pl = PointLaw(law)
+    pts, _ = points(law, 1)
+    prev = np.array([1.0, 1.0])
+    for k in range(len(ly)):
+        f = np.diag([lx[k] / prev[0], ly[k] / prev[1]])[None]
+        mp.update_finite(pts, np.zeros((1, 2)), f - np.eye(2), pl)
+        prev = np.array([lx[k], ly[k]])
+        s = pts.stress[0]
+        assert abs(s[0]) < 1e-10 * abs(s[1]) and abs(s[2]) < 1e-10 * abs(s[1])
+        assert abs(s[1]) * 2.0 * lx[k] == pytest.approx(force[k], rel=1e-10)
+        assert pts.history[0, 4] == pytest.approx(alpha[k], rel=1e-10, abs=1e-14)
+    assert alpha[3] > 0 and alpha[0] == 0  # the path yields
+
+
+def test_j2_tangent_is_the_consistent_one():
+    """The Jacobian of UpdatedLaw's residual (ufl.derivative through the return mapping) against
+    central differences of the residual, in a plastic state with a prestrained F_n."""
+    m = dmesh.create_unit_square(MPI.COMM_SELF, 2, 2, dmesh.CellType.quadrilateral)
+    V = fem.VectorFunctionSpace(m, ("Lagrange", 1))
+    law = J2Plasticity(E, NU, **J2)
+
+    def q(dim, value):
+        e = ufl.VectorElement("Quadrature", m.ufl_cell(), 4, dim=dim, quad_scheme="default")
+        f = fem.Function(fem.FunctionSpace(m, e))
+        f.x.array.reshape(-1, dim)[:] = value
+        return f
+
+    Fn = q(4, [1.05, 0.02, -0.01, 0.97])
+    hist = q(5, [1.02, 0.97, 0.01, 1.01, 0.01])
+    ul = UpdatedLaw(law, Fn, hist, 4)
+    u, v, du = fem.Function(V), ufl.TestFunction(V), ufl.TrialFunction(V)
+    x = V.tabulate_dof_coordinates()[:, :2]
+    u.x.array.reshape(-1, 2)[:] = 0.08 * np.stack([x[:, 0] - 0.5 * x[:, 1], -x[:, 1]], 1)
+    dx = ufl.Measure("dx", domain=m, metadata={"quadrature_degree": 4})
+    R = fem.form(ul.residual(u, v, dx))
+    J = fem.form(ufl.derivative(ul.residual(u, v, dx), u, du))
+    A = fem.petsc.assemble_matrix(J)
+    A.assemble()
+    Jm = A.convert("dense").getDenseArray()
+    w = np.random.default_rng(0).standard_normal(len(u.x.array))
+    u0, d = u.x.array.copy(), 1e-6
+    res = []
+    for sgn in (1, -1):
+        u.x.array[:] = u0 + sgn * d * w
+        res.append(fem.assemble_vector(R).array.copy())
+    fd = (res[0] - res[1]) / (2 * d)
+    assert np.linalg.norm(fd - Jm @ w) < 1e-6 * np.linalg.norm(fd)
+
+
+def test_neo_hookean_under_a_tiny_load_equals_the_linear_path():
+    """A disc squeezed by 1e-6 of its radius per step between grid nodes held at its top and
+    bottom (no contact), one step: neo-Hookean and the small-strain linear path give the same
+    stress at every material point to 2e-6 of the largest (their difference is O(strain); later
+    steps differ by ~5e-4 through the projection at the cut cells' Gauss points outside the
+    body: extrapolated stress on the linear path, the contour's value for F, finite_strain.py)."""
+    h, R = 0.1, 1.0
+    lines = uniform_lines(-1.3, 1.3, h)
+    top = lambda x: x[1] > 0.85 * R  # noqa: E731
+    bottom = lambda x: x[1] < -0.85 * R  # noqa: E731
+    bcs = [Dirichlet(bottom, None, 0.0), Dirichlet(top, 0, 0.0), Dirichlet(top, 1, -1e-6 * R)]
+    stress = []
+    for law in (NeoHookean(E, NU), LinearElastic(E, NU)):
+        body = MPMBody("disc", 1, law, df.Circle((0.0, 0.0), R))
+        build = grid_scene(MPI.COMM_SELF, lines, lines, [("disc", 1)])
+        sim = ImplicitMPM(MPI.COMM_SELF, (lines, lines), [body], build, dirichlet=bcs,
+                          log=lambda *a, **k: None)  # fmt: skip
+        sim.step()
+        stress.append(sim.points[1].stress)
+    scale = np.abs(stress[1]).max()
+    assert scale > 1e-3 * E * 1e-6  # the load reaches the points
+    assert np.abs(stress[0] - stress[1]).max() < 2e-6 * scale
