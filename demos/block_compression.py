@@ -1,27 +1,22 @@
 #!/usr/bin/python3
 """A block compressed between frictionless rigid platens at finite strain: the implicit MPM.
 
-Physics. A width x height block (plane strain) between two frictionless rigid platens wider
-than it, the lower fixed, the upper moved down in --steps equal steps to --compression of the
-height. The law: `linear` (small strain: the points' stress updated by C : d_eps), `neo-hookean`
-or `j2` (finite strain: F and the law's history at the material points, an updated-Lagrangian
-step on the current configuration; j2 is Hencky elasticity with von Mises plasticity and
-linear isotropic hardening, dolfinx_forms/fem/plasticity.py). u_x = 0 on x = 0 (symmetry) holds
-the block's only rigid motion the platens leave free.
+Physics. A width x height block (plane strain) between frictionless rigid platens wider than
+it; the upper moves down in --steps equal steps to --compression of the height. --law linear
+(small strain), neo-hookean or j2 (finite strain: F and the law's history at the points,
+mpm/finite_strain.py; fem/plasticity.py). u_x = 0 on x = 0 holds the only free rigid motion.
 
-The check. The deformation is homogeneous, F = diag(l_x, l_y) with l_y = 1 - compression and
-l_x from the free sides (sigma_xx = 0): the force per unit thickness on the top platen against
-|P_yy| times the initial width (neo-Hookean: closed form; j2: the return mapping integrated
-along the steps; linear: the small-strain update integrated along the steps), the width at
-mid-height against l_x times the width, the level-set area against the points' volume (both
-det F times the initial area), and the mass of the points.
+The check. F = diag(l_x, l_y), l_y = 1 - compression, l_x from sigma_xx = 0: the force per unit
+thickness against |P_yy| times the initial width (neo-Hookean closed form; j2 and linear
+integrated along the steps, analytic.block_*), the width at mid-height against l_x times the
+width, the level-set area against the points' volume, the mass.
 
-Run: /usr/bin/python3 demos/block_compression.py [--law neo-hookean] [--compression 0.4]
-Results and discussion: docs/demos/block_compression.md
+Run: /usr/bin/python3 demos/block_compression.py [--law j2]  (docs/demos/block_compression.md)
 """
 
 import importlib.util
 import sys
+from functools import partial
 
 import numpy as np
 
@@ -51,8 +46,7 @@ OPTIONS = [  # option, kind, default[, help]
     ("--hardening", "[0, inf)", 100.0, "j2: linear isotropic hardening modulus (N/mm^2)"),
     ("--steps", range(1, 10001), 20),
     ("--h", "(0, inf)", 0.05, "grid spacing (mm)"),
-    ("--eps0", cli.MPM_EPS0_INTERVAL, 0.1, "penalty factor (eq 51: eps = eps0 h / (2 E)); "
-     "0.1: penetration about 1e-4 of the height, no checkerboard"),
+    ("--eps0", cli.MPM_EPS0_INTERVAL, 0.1, "penalty factor (eq 51; 0.1: no checkerboard)"),
     ("--series-every", range(1, 10001), 5, "steps between frames of the time series"),
 ]
 COLUMNS = ["step", "compression", "force", "width", "area_levelset", "volume_points"]
@@ -72,21 +66,18 @@ def parse(argv):
 
 
 def make_law(p):
-    if p["law"] == "linear":
-        return LinearElastic(p["E"], p["nu"])
-    if p["law"] == "neo-hookean":
-        return NeoHookean(p["E"], p["nu"])
-    return J2Plasticity(p["E"], p["nu"], p["yield_stress"], p["hardening"])
+    j2 = (p["E"], p["nu"], p["yield_stress"], p["hardening"])
+    return {"linear": LinearElastic, "neo-hookean": NeoHookean}.get(p["law"], J2Plasticity)(
+        *(j2 if p["law"] == "j2" else j2[:2]))  # fmt: skip
 
 
 def reference(p, ly):
     """(force, l_x) of the homogeneous block at the stretches ly (module docstring)."""
-    W, law = p["width"], make_law(p)
-    if p["law"] == "neo-hookean":
-        return analytic.block_neo_hookean(ly, W, law.mu, law.lmbda)
-    if p["law"] == "linear":
-        return analytic.block_hypoelastic(ly, W, p["E"], p["nu"])
-    return analytic.block_j2(ly, W, p["E"], p["nu"], p["yield_stress"], p["hardening"])[:2]
+    W, law, E, nu = p["width"], make_law(p), p["E"], p["nu"]
+    return {"neo-hookean": lambda: analytic.block_neo_hookean(ly, W, law.mu, law.lmbda),
+            "linear": lambda: analytic.block_hypoelastic(ly, W, E, nu),
+            "j2": lambda: analytic.block_j2(ly, W, E, nu, p["yield_stress"], p["hardening"])[:2],
+            }[p["law"]]()  # fmt: skip
 
 
 def evaluate(run):
@@ -103,7 +94,6 @@ def evaluate(run):
         area_vs_points_rel_max=float(np.max(np.abs(area / vol - 1))),
         mass_rel_change=float(abs(recs[-1]["mass"]["block"] / recs[0]["mass"]["block"] - 1)),
         F_yy_points=[float(pts.F[:, 1, 1].min()), float(pts.F[:, 1, 1].max())],
-        newton_iterations=[r["newton_iterations"] for r in recs],
         newton_iterations_mean=float(np.mean([r["newton_iterations"] for r in recs])),
         points_outside_cells_max=int(max(r["points_outside_cells"] for r in recs)),
     )  # fmt: skip
@@ -113,28 +103,25 @@ def evaluate(run):
         if e.max() > TOLERANCE:
             warn.append(f"{name} differs from the homogeneous solution by {e.max():.2%} "
                         f"(> {TOLERANCE:.0%}) at step {int(np.argmax(e)) + 1}")  # fmt: skip
-    if run.results["area_vs_points_rel_max"] > 0.01:
-        warn.append("level-set area and point volume differ by "
-                    f"{run.results['area_vs_points_rel_max']:.1%} (> 1 %)")  # fmt: skip
+    if (av := run.results["area_vs_points_rel_max"]) > 0.01:
+        warn.append(f"level-set area and point volume differ by {av:.1%} (> 1 %)")
 
 
 def summary(run):
-    r = run.results
-    return (
-        f"Block ({run.params['law']}): {len(run.rows)} steps to {run.rows[-1]['compression']:.3g}"
-        f" compression, F = {r['force'][-1]:.6g} N/mm (homogeneous {run.analytic['force'][-1]:.6g}"
-        f"), max force error {r['force_rel_error_max']:.2e}, width {r['width_rel_error_max']:.2e}"
-        f", area vs points {r['area_vs_points_rel_max']:.1e}, Newton "
-        f"{r['newton_iterations_mean']:.1f} per step"
-    )
+    r, p = run.results, run.params
+    return (f"Block ({p['law']}): {len(run.rows)} steps to {run.rows[-1]['compression']:.3g}, "
+            f"F = {r['force'][-1]:.6g} N/mm (homogeneous {run.analytic['force'][-1]:.6g}), max "
+            f"errors: force {r['force_rel_error_max']:.2e}, width {r['width_rel_error_max']:.2e}"
+            f", area vs points {r['area_vs_points_rel_max']:.1e}; Newton "
+            f"{r['newton_iterations_mean']:.1f} per step")  # fmt: skip
 
 
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
     with Run("block_compression", vars(args), discretization="cut", plot=False) as run:
         # the scene: the block's level set and points between the two platens
-        scene_args = (args.width, args.height, args.h, args.compression, args.steps)
-        grid, (name, tag, shape), platens, scene = block_between_platens(run.comm, *scene_args)
+        grid, (name, tag, shape), platens, scene = block_between_platens(
+            run.comm, args.width, args.height, args.h, args.compression, args.steps)  # fmt: skip
         # the problem: frictionless platens, u_x = 0 on x = 0
         symmetry = Dirichlet(lambda x: np.isclose(x[0], 0.0, atol=1e-9 * args.width), 0, 0.0)
         body = MPMBody(name, tag, make_law(vars(args)), shape)
@@ -144,22 +131,18 @@ def main(argv=None):
         # the run: the upper platen moves down by compression x height / steps per step
         steps = Steps(run, sim, COLUMNS, args.steps, args.series_every)
         for _ in range(args.steps):
-            rec = steps.step()
-            k = rec["step"]
-            steps.rows.append(dict(
-                step=k, compression=k * args.compression / args.steps,
+            rec, k = steps.step(), len(steps.rows) + 1
+            steps.rows.append(dict(step=k, compression=k * args.compression / args.steps,
                 force=rec["obstacles"]["platen_top"]["fy"],
                 width=width_at(sim.levelsets[tag], *grid, 0.0),
                 area_levelset=rec["area_levelset"]["block"],
                 volume_points=rec["volume_points"]["block"],
             ))  # fmt: skip
         steps.measure()
-
         # the check (rank 0): force and width against the homogeneous solution
         if run.rank0:
             evaluate(run)
-        run.finish(summary, **steps.outputs(lambda run, folder: block_plots(run, folder,
-                                                                             reference)))
+        run.finish(summary, **steps.outputs(partial(block_plots, reference=reference)))
     return run.status
 
 

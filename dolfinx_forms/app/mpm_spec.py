@@ -14,7 +14,8 @@ in brackets; lengths and forces in the scene's units, angles in degrees):
       [4], num_gauss [2], linear_solver ["auto"], petsc {KEY = VALUE}, newton {rtol, ftol,
       atol, stol, max_iterations, max_cutbacks}, predictor_gap [0], reinit_drift [0.2]
   [[bodies]]  name, shape (circle, ellipse, box, polygon: as scene_spec), law = {type =
-      "linear", E, nu} | {type = "orthotropic", ...} (small strain per step: linear laws)
+      "linear", E, nu} | {type = "orthotropic", ...} (small strain per step) | {type =
+      "neo-hookean", E, nu} (finite strain: F at the points, mpm/finite_strain.py)
   [[obstacles]]  name, shape (any shape of scene_spec, half_plane included: normal outward
       from the obstacle), centre [the shape's centre; a half-plane's point; a polygon's
       vertex mean] (the point it turns about and its moment is taken about), bodies [every
@@ -58,7 +59,7 @@ from dolfinx_forms.app.spec_values import (
 )
 
 MAX_GRID_CELLS = 16_000_000  # 4000 x 4000
-MPM_LAWS = ("linear", "orthotropic")
+MPM_LAWS = ("linear", "orthotropic", "neo-hookean")
 MAX_STEPS = 100_000
 
 
@@ -153,8 +154,7 @@ def _bodies(top, base_dir):
         if law["type"] not in MPM_LAWS:
             raise SpecError(
                 b.path("law.type"),
-                f"the multi-step path takes linear laws ({', '.join(MPM_LAWS)}): its stress "
-                f"update is C : d_eps per step, got {law['type']!r}",
+                f"the multi-step path takes the laws {', '.join(MPM_LAWS)}, got {law['type']!r}",
             )
         bodies[name] = {"name": name, "shape": shape, "law": law}
         b.done()

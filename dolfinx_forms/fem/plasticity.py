@@ -93,12 +93,13 @@ class J2Plasticity(IsotropicLaw):
     def return_map(self, eps, alpha):
         """Radial return in logarithmic strain: (elastic strain, dgamma). A small-strain
         return mapping of another law replaces this function."""
-        G, K, H = self.mu, self.K, self.hardening
+        G, H = self.mu, self.hardening
         e = ufl.dev(eps)
         q = ufl.sqrt(1.5 * ufl.inner(2 * G * e, 2 * G * e))
         phi = q - (self.yield_stress + H * alpha)
         dgamma = ufl.max_value(phi, 0.0) / (3 * G + H)
-        scale = ufl.conditional(ufl.gt(phi, 0.0), 1 - 3 * G * dgamma / ufl.max_value(q, 1e-300), 1.0)
+        shrink = 1 - 3 * G * dgamma / ufl.max_value(q, 1e-300)
+        scale = ufl.conditional(ufl.gt(phi, 0.0), shrink, 1.0)
         return ufl.tr(eps) / 3 * ufl.Identity(3) + scale * e, dgamma
 
     def tau3(self, f, h):

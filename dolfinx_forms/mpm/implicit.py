@@ -24,8 +24,11 @@ Nothing persistent changes before step 4 converges, and `snapshot`/`restore` cop
 of state (points, level sets, obstacle poses, friction record, counters): a rejected step leaves
 the simulation exactly as it was.
 
-Small strain per step with the Jaumann update of the points' stress (material_points.py);
-laws must be linear (law_tangent). The background grid must be uniform (WENO5).
+Linear laws: small strain per step with the Jaumann update of the points' stress
+(material_points.py). Finite-strain laws (`Law.finite_strain`: NeoHookean, J2Plasticity, user
+laws): F and the law's history at the points, an updated-Lagrangian step on Omega_n
+(finite_strain.py). Other nonlinear laws are refused. The background grid must be uniform
+(WENO5).
 """
 
 from __future__ import annotations
@@ -121,7 +124,9 @@ class ImplicitMPM:
             elif key not in tangents:
                 tangents[key] = mp.law_tangent(law)  # ValueError for other nonlinear laws
         self.C = {t: tangents[law_key(w)] for t, w in self.laws.items() if not w.finite_strain}
-        self.point_laws = {t: point_laws[law_key(w)] for t, w in self.laws.items() if w.finite_strain}
+        self.point_laws = {
+            t: point_laws[law_key(w)] for t, w in self.laws.items() if w.finite_strain
+        }
         self.levelsets = {}
         for b in self.bodies:
             if isinstance(b.shape, _cpp.LevelSet):

@@ -18,8 +18,8 @@ _spec.loader.exec_module(demo)
 @pytest.mark.parametrize("law", ["neo-hookean", "j2", "linear"])
 def test_coarse_run_against_the_homogeneous_solution(law, tmp_path):
     """h = height/40, 20 % compression in 8 steps. Measured force errors 0.56 % (neo-Hookean),
-    0.68 % (j2), 1.04 % (linear) here, from the level-set corners at the platens (the
-    level-set corners at the platens, docs/demos/block_compression.md): 2 % is the demo's own
+    0.68 % (j2), 1.04 % (linear) here, from the level-set corners at the platens
+    (docs/demos/block_compression.md): 2 % is the demo's own
     tolerance; the width at mid-height within 2 %; area and point volume within 1 %."""
     out = tmp_path / law
     args = ["--law", law, "--h", "0.05", "--steps", "8", "--compression", "0.2"]
