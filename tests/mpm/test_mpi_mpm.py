@@ -140,3 +140,31 @@ def test_dense_assembly_pairs_split_evenly_over_two_ranks():
         assert np.max(np.abs(p.x[op] - s.x[os_])) <= 1e-8 * du
         scale = np.max(np.abs(s.stress))
         assert np.max(np.abs(p.stress[op] - s.stress[os_])) <= 1e-8 * scale
+
+
+@pytest.mark.mpi
+def test_finite_strain_j2_block_two_ranks_match_one():
+    """The finite-strain path (F and J2's history at the points, projected per rank to the
+    rank's cells; the point law on each rank's own helper mesh): platen forces and the points'
+    F and plastic strain on 2 ranks equal to 1 rank's, 1e-8."""
+    from dolfinx_forms.fem.boundary import Dirichlet
+    from dolfinx_forms.fem.plasticity import J2Plasticity
+    from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
+    from meshes.mpm import block_between_platens
+
+    out = []
+    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
+        grid, (name, tag, shape), platens, build = block_between_platens(
+            comm, 2.0, 2.0, 0.1, 0.1, 4
+        )
+        body = MPMBody(name, tag, J2Plasticity(1000.0, 0.3, 50.0, 100.0), shape)
+        sym = Dirichlet(lambda x: np.isclose(x[0], 0.0), 0, 0.0)
+        sim = ImplicitMPM(comm, grid, [body], build, obstacles=platens, dirichlet=[sym], mu=0.0,
+                          eps0=0.1, newton=NewtonOptions(rtol=1e-13), log=lambda *a, **k: None)
+        forces = [sim.step()["obstacles"]["platen_top"]["fy"] for _ in range(4)]
+        p = sim.points[1]
+        o = np.lexsort(np.round(p.x.T / 1e-9))
+        out.append((forces, p.F[o], p.history[o, 4]))
+    (fp, Fp, ap), (fs, Fs, as_) = out
+    assert np.allclose(fp, fs, rtol=1e-8, atol=0) and max(as_) > 0
+    assert np.allclose(Fp, Fs, rtol=0, atol=1e-8) and np.allclose(ap, as_, rtol=0, atol=1e-10)
