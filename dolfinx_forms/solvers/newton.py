@@ -112,7 +112,8 @@ def newton(problem, lam, r_ref=0.0, early=0.0):
                 (
                     f"non-finite residual at iteration {it} (a singular system? every body needs "
                     "its rigid motions held by Dirichlet conditions or by contact; a frictionless "
-                    "body can slide along the contact)"
+                    "body can slide along the contact. Finite strain: det F <= 0 at an "
+                    "integration point, a step too large for the grid)"
                 ),
             )
         if r0 is None:
