@@ -56,7 +56,7 @@ TOLERANCE = 0.02  # force and width against the homogeneous solution (docs/demos
 
 def parse(argv):
     p = cli.demo_parser("block_compression.py", __doc__, "results/block_compression", OPTIONS,
-                        discretization=False, enforcement=cli.MPM_ENFORCEMENT)  # fmt: skip
+                        discretization=False, multi_step=True)  # fmt: skip
     a = p.parse_args(argv)
     try:
         check_block(a.width, a.height, a.h, a.compression, a.steps)

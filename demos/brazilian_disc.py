@@ -54,7 +54,7 @@ COLUMNS = ["step", "displacement", "force_top", "force_bottom", "half_width_top"
 
 def parse(argv):
     p = cli.demo_parser("brazilian_disc.py", __doc__, "results/brazilian_disc", OPTIONS,
-                        discretization=False, enforcement=cli.MPM_ENFORCEMENT)  # fmt: skip
+                        discretization=False, multi_step=True)  # fmt: skip
     a = p.parse_args(argv)
     try:  # 10 to 4000 cells across, small strain, at most h/2 per step
         check_brazilian_disc(a.R, a.h, a.steps, a.step_displacement)

@@ -55,7 +55,7 @@ CLEARANCE = 0.25  # mm between a plate's end and the perpendicular plate's inner
 
 def parse(argv):
     p = cli.demo_parser("four_grains.py", __doc__, "results/four_grains", OPTIONS,
-                        discretization=False, enforcement=cli.MPM_ENFORCEMENT)  # fmt: skip
+                        discretization=False, multi_step=True)  # fmt: skip
     a = p.parse_args(argv)
     try:  # the arrangement depends on the seed (numpy only, ~0.5 s): checked before any output
         travel = a.steps * a.displacement

@@ -55,7 +55,7 @@ COLUMNS = ["step", "phase"] + [f"{p}_{c}" for p in PLATES for c in ("normal", "t
 
 def parse(argv):
     p = cli.demo_parser("grain_assembly.py", __doc__, "results/grain_assembly", OPTIONS,
-                        discretization=False, enforcement=cli.MPM_ENFORCEMENT)  # fmt: skip
+                        discretization=False, multi_step=True)  # fmt: skip
     a = p.parse_args(argv)
     if not 5 <= a.radius / a.h <= 100:
         p.error(f"--h: must give 5 <= radius/h <= 100 (radius {a.radius:g}), got {a.h}")

@@ -51,7 +51,7 @@ COLUMNS = ["step", "displacement", "force_left", "force_right", "force_bottom", 
 
 def parse(argv):
     p = cli.demo_parser("nine_discs.py", __doc__, "results/nine_discs", OPTIONS,
-                        discretization=False, enforcement=cli.MPM_ENFORCEMENT)  # fmt: skip
+                        discretization=False, multi_step=True)  # fmt: skip
     a = p.parse_args(argv)
     k = (3 * a.R + 1.0) / a.h
     if abs(k - round(k)) > 1e-9 * k or not 10 <= a.R / a.h <= 200:

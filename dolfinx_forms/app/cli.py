@@ -120,6 +120,8 @@ class DemoParser(argparse.ArgumentParser):
             and not any(t == "--eps0" or str(t).startswith("--eps0=") for t in given)
         ):
             a.eps0 = defaults.TUNING.augmented_eps0  # eps0 sets the loop's speed only: the fast one
+        if getattr(self, "_multi_step", False) and hasattr(a, "eps0"):
+            check_mpm_eps0(self, a)
         if getattr(a, "verbose", False):
             set_verbose(True)
         if self._out_dest is not None:
@@ -425,13 +427,17 @@ def demo_parser(
     petsc=True,
     cells=None,
     enforcement=("penalty", "augmented"),
+    multi_step=False,
 ):
     """A demo's parser: the description is the first paragraph of `doc`; --out (default `out`)
     and --force, --discretization and --ghost-penalty (add_discretization), the `options`
     table (add_options), --quads/--triangles (add_cells, with cells = (quads by default,
     help of --quads, help of --triangles)), --enforcement with the `enforcement` choices,
-    --linear-solver, --petsc (add_petsc)."""
+    --linear-solver, --petsc (add_petsc). multi_step: a demo of the MPM (MPM_ENFORCEMENT, and
+    --eps0 checked by check_mpm_eps0)."""
     p = DemoParser(prog=prog, description=doc.split("\n\n")[0])
+    p._multi_step = multi_step
+    enforcement = MPM_ENFORCEMENT if multi_step else enforcement
     p.add_out(out)
     if discretization:
         add_discretization(p)
@@ -439,7 +445,7 @@ def demo_parser(
     if cells is not None:
         add_cells(p, *cells)
     if petsc:
-        add_enforcement(p, enforcement)
+        add_enforcement(p, enforcement, multiplier_mass=not multi_step)
         add_linear_solver(p)
         add_petsc(p)
     return p
@@ -463,10 +469,9 @@ def check_scale(parser, args, size, what, max_cells=2000, displacement=True):
 
 
 
-# the multi-step MPM runs the penalty only (`mpm.ImplicitMPM` refuses the other: its grains'
-# contacts span about one cell, and P1 multipliers h apart widen and soften such a contact,
-# `checks.MIN_NODES`): its demos' --enforcement choices
-MPM_ENFORCEMENT = ("penalty",)
+# the multi-step MPM's --enforcement choices: the penalty, or the augmented Lagrangian (its
+# multipliers and friction tractions carried from step to step, mpm/records.py)
+MPM_ENFORCEMENT = ("penalty", "augmented")
 
 # the multi-step MPM's accepted penalty factors eps0 (eq 51: eps = eps0 h / E_c), on every
 # path (the demos' --eps0, a description's solver.eps0). Measured on the four MPM demos at
@@ -477,16 +482,29 @@ MPM_ENFORCEMENT = ("penalty",)
 # answer). Hence no softer penalty than eps0 = 1: forces within 40 % of the rigid limit. Stiffer
 # penalties give forces closer to it or a Newton failure (exit 1, one line: the grain assembly
 # at eps0 <= 0.1, the grains at 1e-3); below 1e-4 Newton fails on every demo: refused.
+# With the augmented Lagrangian eps0 sets only the Uzawa loop's speed: [1e-4, 1e4] (the
+# parser's interval MPM_EPS0_INTERVAL; the penalty's narrower range is checked after parsing).
 MPM_EPS0 = (1e-4, 1.0)
-MPM_EPS0_INTERVAL = "[1e-4, 1]"
+MPM_EPS0_AUGMENTED = (1e-4, 1e4)
+MPM_EPS0_INTERVAL = "[1e-4, 1e4]"
 MPM_EPS0_HELP = (
-    "penalty factor of eq 51, eps = eps0 h / E_c, in [1e-4, 1]: smaller is stiffer, closer to "
-    "rigid contact (forces at 1: 15-36 %% under the rigid limit); above 1 the bodies pass "
-    "through each other (forces 1e5x too small at 1e6), below 1e-4 Newton fails"
+    "eq 51, eps = eps0 h / E_c. Penalty: in [1e-4, 1], smaller is stiffer, closer to rigid "
+    "contact (forces at 1: 15-36 %% under the rigid limit); above 1 the bodies pass through "
+    "each other, below 1e-4 Newton fails. Augmented: in [1e-4, 1e4], the loop's speed only"
 )
 
 
-def add_enforcement(parser, choices=("penalty", "augmented")):
+def check_mpm_eps0(parser, args):
+    """--eps0 within MPM_EPS0 with --enforcement penalty (parser.error, exit 2)."""
+    if args.enforcement == "penalty" and not MPM_EPS0[0] <= args.eps0 <= MPM_EPS0[1]:
+        parser.error(
+            f"--eps0: must be in [{MPM_EPS0[0]:g}, {MPM_EPS0[1]:g}] with --enforcement penalty "
+            f"(above 1 the bodies pass through each other; augmented takes up to 1e4), got "
+            f"{args.eps0:g}"
+        )
+
+
+def add_enforcement(parser, choices=("penalty", "augmented"), multiplier_mass=True):
     """--enforcement: penalty (eqs 8, 12) or augmented Lagrangian (Uzawa, seed 003); a demo of
     the multi-step MPM offers MPM_ENFORCEMENT."""
     parser.add_argument(
@@ -501,7 +519,7 @@ def add_enforcement(parser, choices=("penalty", "augmented")):
             else "contact enforcement: the multi-step MPM runs the penalty only"
         ),
     )
-    if "augmented" in choices:
+    if "augmented" in choices and multiplier_mass:  # the MPM's multipliers are point-wise
         from dolfinx_forms.geometry.pairs import DEFAULT_MULTIPLIER_MASS, MULTIPLIER_MASSES
 
         parser.add_argument(

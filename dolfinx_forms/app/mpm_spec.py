@@ -9,7 +9,8 @@ in brackets; lengths and forces in the scene's units, angles in degrees):
   [units]  length [""], force [""]: the labels of the plots ("mm", "N")
   [grid]  extent = [[x_min, y_min], [x_max, y_max]] (rounded outwards to multiples of h), h
       (the uniform background grid of the level sets and the cut cells)
-  [solver]  mu [0], eps0 [1.0] (eq 51 penalty, in [1e-4, 1]: cli.MPM_EPS0; penalty only), band
+  [solver]  enforcement ["penalty"] or "augmented", mu [0], eps0 [1.0; augmented 1e-2] (eq 51:
+      the penalty in [1e-4, 1], cli.MPM_EPS0; augmented: the loop's speed, [1e-4, 1e4]), band
       [2 h; doubled while active points reach its edge], ghost_penalty [0.01], grid_refine
       [4], num_gauss [2], linear_solver ["auto"], petsc {KEY = VALUE}, newton {rtol, ftol,
       atol, stol, max_iterations, max_cutbacks}, predictor_gap [0], reinit_drift [0.2]
@@ -81,16 +82,24 @@ def _grid(t):
     return g
 
 
-def _eps0(t):
-    """solver.eps0 in the range the MPM demos' --eps0 accept (cli.MPM_EPS0: measured)."""
-    from dolfinx_forms.app.cli import MPM_EPS0, MPM_EPS0_INTERVAL
+def _eps0(t, enforcement):
+    """solver.eps0 in the range the MPM demos' --eps0 accept: cli.MPM_EPS0 with the penalty
+    (measured), cli.MPM_EPS0_AUGMENTED with the augmented Lagrangian (the loop's speed)."""
+    from dolfinx_forms.app.cli import MPM_EPS0, MPM_EPS0_AUGMENTED
 
-    eps0 = t.number("eps0", 1.0, lo=0, lo_open=True)
-    if not MPM_EPS0[0] <= eps0 <= MPM_EPS0[1]:
+    lo, hi = MPM_EPS0 if enforcement == "penalty" else MPM_EPS0_AUGMENTED
+    eps0 = t.number("eps0", 1.0 if enforcement == "penalty" else 1e-2, lo=0, lo_open=True)
+    if not lo <= eps0 <= hi:
+        why = (
+            "above 1 the bodies pass through each other: forces 1e5x too small at 1e6; below "
+            "1e-4 Newton fails; the augmented Lagrangian takes up to 1e4"
+            if enforcement == "penalty"
+            else "it sets the Uzawa loop's speed only"
+        )
         raise SpecError(
             t.path("eps0"),
-            f"must be in {MPM_EPS0_INTERVAL} on the multi-step path (above 1 the bodies pass "
-            f"through each other: forces 1e5x too small at 1e6; below 1e-4 Newton fails), "
+            f"must be in {'[1e-4, 1]' if enforcement == 'penalty' else '[1e-4, 1e4]'} on the "
+            f"multi-step path with {enforcement} ({why}), "
             f"got {eps0:g}",
         )
     return eps0
@@ -98,16 +107,10 @@ def _eps0(t):
 
 def _solver(t):
     enforcement = t.string("enforcement", "penalty", choices=["penalty", "augmented"])
-    if enforcement != "penalty":
-        raise SpecError(
-            "solver.enforcement",
-            "the multi-step path supports 'penalty' only (its friction transfer carries "
-            "point-wise slip from step to step)",
-        )
     s = dict(
-        enforcement="penalty",
+        enforcement=enforcement,
         mu=t.number("mu", 0.0, lo=0),
-        eps0=_eps0(t),
+        eps0=_eps0(t, enforcement),
         band=t.number("band", None, lo=0, lo_open=True),
         ghost_penalty=t.number("ghost_penalty", 0.01, lo=0),
         grid_refine=t.integer("grid_refine", 4, lo=1, hi=16),

@@ -146,6 +146,9 @@ class ContactSet(Multipliers):
         # current ones and the committed tractions they start from
         self.lambda_n = [np.zeros(g.num_law_points) for g in self.pairs]
         self.lambda_t = [np.zeros(g.num_law_points) for g in self.pairs]
+        # tractions a pair without a committed state starts from (the material-point path
+        # carries them from the previous step's points: `set_start_tractions`)
+        self.start_tractions = [None] * len(self.pairs)
         # where friction was switched on (displacement, load level; None: from the start, at
         # u = 0): the slip origin of points a rebuild adds (`contact.band`)
         self.friction_origin = None
@@ -263,6 +266,11 @@ class ContactSet(Multipliers):
         self.history[k].trial = gtp
         self.history[k].commit()
         self.slip_start[k] = gtp.copy()
+
+    def set_start_tractions(self, k, tau_n, tau_t):
+        """Pair k's multipliers start from these law-point tractions while it has no committed
+        state (the material-point transfer of a new step's points; Multipliers.start_step)."""
+        self.start_tractions[k] = (np.asarray(tau_n, float), np.asarray(tau_t, float))
 
     def elastic_slip(self, k):
         """The committed elastic tangential gap g_t - g_t^p of pair k's points (eq 31), for

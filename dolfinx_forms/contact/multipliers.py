@@ -8,11 +8,13 @@ import numpy as np
 
 
 class Multipliers:
-    """Mixin of ContactSet: needs its pairs, committed, last, mu, eps_t, eps_t_start,
-    lambda_n and lambda_t."""
+    """Mixin of ContactSet: needs its pairs, committed, start_tractions, last, mu, eps_t,
+    eps_t_start, lambda_n and lambda_t."""
 
     def _committed_tractions(self, k):
         c = self.committed[k]
+        if c is None and self.start_tractions[k] is not None:
+            return self.start_tractions[k]
         zero = np.zeros(self.pairs[k].num_law_points)
         return (zero, zero) if c is None else (c["law_tau_n"], c["law_tau_t"])
 

@@ -141,19 +141,15 @@ class ImplicitMPM:
         self.reinit_drift = float(reinit_drift)
         self.timer = timer
         self.log = log if comm.rank == 0 else (lambda *a, **k: None)
-        if problem_kw.get("enforcement", "penalty") != "penalty":
-            raise ValueError(
-                "enforcement: the multi-step MPM supports 'penalty' only (its friction transfer "
-                "carries point-wise slip from step to step, and its contacts span about one "
-                "grid cell, too few for the augmented Lagrangian's P1 multipliers)"
-            )
         options(**problem_kw)  # an unknown option fails here, not at the first step
         self.problem_kw = problem_kw
         # the contact band (the largest initial gap Gamma_c covers): the given one or 2 h to
         # start, doubled whenever a converged step has active points near its edge (`step`)
         self.band = float(problem_kw.pop("band", None) or 2 * self.h)
         self.points = None  # {tag: MaterialPoints}, seeded on the first scene
-        self.friction = {}  # pair key -> (points (n, 2), elastic tangential gap (n,))
+        # pair key -> (points (n, 2), elastic tangential gap, tau_n, tau_t (n,)): the contact
+        # state the next step's points start from (records.transfer_friction)
+        self.friction = {}
         self.step_count = 0
         self.problem = None
         self.scene = None
@@ -171,7 +167,7 @@ class ImplicitMPM:
                 t: _cpp.LevelSet(self.grid, l.values.ravel()) for t, l in self.levelsets.items()
             },
             obstacles=[ob.state() for ob in self.obstacles],
-            friction={k: (x.copy(), e.copy()) for k, (x, e) in self.friction.items()},
+            friction={k: tuple(a.copy() for a in v) for k, v in self.friction.items()},
             step_count=self.step_count,
         )
 
@@ -184,7 +180,7 @@ class ImplicitMPM:
         }
         for ob, s in zip(self.obstacles, snap["obstacles"]):
             ob.set_state(s)
-        self.friction = {k: (x.copy(), e.copy()) for k, (x, e) in snap["friction"].items()}
+        self.friction = {k: tuple(a.copy() for a in v) for k, v in snap["friction"].items()}
         self.step_count = snap["step_count"]
 
     # ------------------------------------------------------------------ one step

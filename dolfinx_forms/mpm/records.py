@@ -36,23 +36,31 @@ def support_forces(sim, problem, scene):
 
 
 def transfer_friction(sim, problem, keys):
-    """Each new contact point starts from the elastic tangential gap e_t = g_t - g_t^p of
-    the nearest contact point of the same pair in the previous step (moved with the
-    bodies) if one lies within h, else from zero tangential traction: its committed slip is
-    set to -e_t, so the trial traction at du = 0 is the old one (eq 11)."""
+    """Each new contact point starts from the state of the nearest contact point of the same
+    pair in the previous step if one lies within h (else from zero): its elastic tangential
+    gap e_t = g_t - g_t^p (the committed slip is set to -e_t, so the trial traction at du = 0
+    is the old one, eq 11) and, with the augmented Lagrangian, its tractions, where the step's
+    multipliers start (the Uzawa loop then needs few updates)."""
     cs = problem.contact
-    if cs.mu == 0:
+    if cs.mu == 0 and not cs.augmented:
         return
     from scipy.spatial import cKDTree
 
     for k, g in enumerate(cs.pairs):
         old = sim.friction.get(keys[k])
-        gtp = np.zeros(len(g.weights))
+        n = len(g.weights)
+        if g.num_law_points != n:  # the law at multiplier nodes: no point-wise record
+            continue
+        gtp, tn, tt = np.zeros(n), np.zeros(n), np.zeros(n)
         if old is not None and len(old[0]):
             d, idx = cKDTree(old[0]).query(g.points)
             near = d <= sim.h
             gtp[near] = -old[1][idx[near]]
-        cs.set_committed_slip(k, gtp)
+            tn[near], tt[near] = old[2][idx[near]], old[3][idx[near]]
+        if cs.mu > 0:
+            cs.set_committed_slip(k, gtp)
+        if cs.augmented:
+            cs.set_start_tractions(k, tn, tt)
 
 
 def contact_record(sim, problem, scene, keys):
@@ -88,8 +96,10 @@ def contact_record(sim, problem, scene, keys):
                 num_points=int(len(w)),
             )
         )
-        if cs.mu > 0:
-            sim.friction[keys[k]] = (g.points.copy(), cs.elastic_slip(k))
+        if (cs.mu > 0 or cs.augmented) and g.num_law_points == len(w):
+            zero = np.zeros(len(w))
+            slip = cs.elastic_slip(k) if cs.mu > 0 else zero
+            sim.friction[keys[k]] = (g.points.copy(), slip, s["law_tau_n"], s["law_tau_t"])
     # each pair lives on one rank: share the records, in the order of one rank
     gathered = sim.comm.allgather(list(zip(cs.index, pairs)))
     pairs = [p for _, p in sorted((q for lst in gathered for q in lst), key=lambda q: q[0])]

@@ -112,7 +112,8 @@ BASE = {
 BAD = [  # (override, the key the message names, a word of the message)
     ("bodies[0].shape={type='half_plane', point=[0.0, 0.0], normal=[0.0, 1.0]}",
      "bodies[0].shape.type", "bounded"),
-    ("solver.enforcement='augmented'", "solver.enforcement", "penalty"),
+    ("solver.enforcement='lagrange'", "solver.enforcement", "penalty"),
+    ("solver={enforcement='augmented', eps0=1e5}", "solver.eps0", "1e4"),
     ("obstacles[0].shape.point=[0.0, -0.5]", "obstacles[0]", "deeper than h/2"),
     ("bodies[0].shape.centre=[1.5, 0.0]", "bodies[0]", "not inside the grid"),
     ("grid.h=0.6", "grid.h", "quarter"),

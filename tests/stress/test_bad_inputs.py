@@ -105,9 +105,10 @@ CASES = [
     ("patch_test", "--enforcement lagrange", "--enforcement"),
     ("inclined_interface", "--supports fixed", "--supports"),
     ("brazilian_disc", "--enforcement bogus", "--enforcement"),
-    # the multi-step MPM runs the penalty only: refused, not silently a stiff penalty
-    ("grain_assembly", "--enforcement augmented", "--enforcement"),
-    ("nine_discs", "--enforcement augmented", "--enforcement"),
+    # the multi-step MPM: its multipliers carry no mass option; the penalty's eps0 <= 1
+    ("grain_assembly", "--enforcement augmented --multiplier-mass lumped", "--multiplier-mass"),
+    ("nine_discs", "--eps0 10", "--eps0"),
+    ("nine_discs", "--enforcement augmented --eps0 1e5", "--eps0"),
     ("convergence_study", "--discretization CUT", "--discretization"),
     ("two_blocks", "--quads --triangles", "--triangles"),  # mutually exclusive
     # ------------------------------------------------ mesh sizes absurd for the geometry
