@@ -276,3 +276,22 @@ def width_at(levelset, xlines, ylines, y):
         phi[i1] - phi[i1 + 1]
     )
     return float(right - left)
+
+
+def flat_punch(comm, a=1.0, h=0.05, radius=7.0):
+    """A rigid flat punch of half-width a (a box [-a, a] x [0, 2a], sharp corners: its exact
+    signed distance) on an elastic half-space modelled as the half-disc y < 0 of radius
+    `radius` a, whose arc is fixed (the grid nodes within 3h/4 of it). Returns (grid lines,
+    (name, tag, shape), punch, fixed-arc Dirichlet, build_scene). The half-disc's top lies
+    mid-way between grid lines (y lines at (k + 1/2) h); x lines at k h."""
+    R = radius * a
+    xl = uniform_lines(-R - 3 * h, R + 3 * h, h)
+    yl = uniform_lines(-R - 3 * h, 2 * a, h) + 0.5 * h
+    shape = df.Intersection([df.Circle((0.0, 0.0), R), half_plane((0, 0), (0, 1), 100 * R)])
+    punch = RigidObstacle(
+        "punch", df.Box([-a, 0.0], [a, 2 * a]), bbox=[[-a, 0.0], [a, 2 * a]], center=(0.0, 0.0)
+    )
+    fixed = Dirichlet(lambda x: x[0] ** 2 + x[1] ** 2 >= (R - 0.75 * h) ** 2, None, 0.0)
+    box = np.array([[[-2 * a, -a], [2 * a, 2 * a]]])  # the contact zone, on one rank
+    build = grid_scene(comm, xl, yl, [("halfspace", 1)], contact_box=box)
+    return (xl, yl), ("halfspace", 1, shape), punch, fixed, build

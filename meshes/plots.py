@@ -79,6 +79,26 @@ def block_plots(run, folder, reference):
     _save(plt, fig, folder / "F_yy.png")
 
 
+def flat_punch_plot(run, folder, tab, johnson):
+    """demos/flat_punch.py: tractions.png, p_n and p_t at the contact points against
+    johnson(x, a, P, nu, adhesive) -> (p, q)."""
+    plt = _pyplot()
+    p = run.params
+    adhesive = p["adhesive"]
+    xs = np.linspace(-0.98, 0.98, 400) * p["a"]
+    pj, qj = johnson(xs, p["a"], p["P"], p["nu"], adhesive)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(xs, pj, "k-", label="Johnson p")
+    ax.plot(tab[:, 0], tab[:, 1], ".", ms=3, label="MPM p_n")
+    if adhesive:
+        ax.plot(xs, qj, "k--", label="Johnson q")
+        ax.plot(tab[:, 0], tab[:, 2], ".", ms=3, label="MPM p_t")
+    ax.set(xlabel="x (mm)", ylabel="traction (N/mm^2)", ylim=(min(0, qj.min()) * 1.5, 4 * pj.min()),
+           title="Flat punch: contact tractions")  # fmt: skip
+    ax.legend()
+    _save(plt, fig, folder / "tractions.png")
+
+
 def max_principal(s):
     """Largest principal stress of [s_xx, s_yy, s_xy] rows."""
     return 0.5 * (s[:, 0] + s[:, 1]) + np.hypot(0.5 * (s[:, 0] - s[:, 1]), s[:, 2])

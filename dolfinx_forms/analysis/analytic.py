@@ -166,3 +166,19 @@ def block_j2(ly, width, E, nu, yield_stress, hardening):
         be, alpha, lx0, y0 = np.exp(2 * e), alpha + dg, lx, y
         out.append((abs(tau[1]) / y * width, lx, alpha))
     return tuple(np.array(v) for v in zip(*out))
+
+
+# ---------------------------------------------------------------- flat punch (Johnson 1985, 2.8)
+def flat_punch(x, a, P, nu, adhesive=False):
+    """Pressure p(x) and shear q(x) (on the half-space, along +x) under a rigid flat punch of
+    half-width a pressed with P per unit thickness into an elastic half-space (plane strain),
+    |x| < a. Frictionless: p = P / (pi sqrt(a^2 - x^2)), q = 0. Adhesive (no slip anywhere):
+    p, q = c P / (pi sqrt(a^2 - x^2)) (cos, sin)(eta ln((a + x) / (a - x))), c = 2 (1 - nu) /
+    sqrt(3 - 4 nu), eta = ln(3 - 4 nu) / (2 pi)."""
+    x = np.asarray(x, float)
+    base = P / (np.pi * np.sqrt(a**2 - x**2))
+    if not adhesive:
+        return base, np.zeros_like(base)
+    eta, c = np.log(3 - 4 * nu) / (2 * np.pi), 2 * (1 - nu) / np.sqrt(3 - 4 * nu)
+    L = eta * np.log((a + x) / (a - x))
+    return c * base * np.cos(L), c * base * np.sin(L)
