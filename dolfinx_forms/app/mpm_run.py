@@ -198,6 +198,7 @@ class Steps:
             newton_iterations=[r["newton_iterations"] for r in self.records],
             converged=True,
             residual_history=[r["residuals"] for r in self.records],  # per step
+            enforcement=sim.problem.contact.enforcement,
             penalty={"eps_n": sim.problem.eps_n, "eps_t": sim.problem.eps_t},
             linear_solver=sim.problem.linear.name,  # the last step's
             condensed_dofs=int(getattr(sim.problem.linear, "num_dofs", 0)),

@@ -232,7 +232,7 @@ def make_simulation(spec, comm, timer=None, log=print):
     tags = [(b.name, b.tag) for b in bodies]
     build = grid_scene(comm, g["xlines"], g["ylines"], tags, contact_box=False)
     obstacles, dirichlet = make_obstacles(spec), make_dirichlet(spec)
-    named = "mu eps0 ghost_penalty grid_refine num_gauss predictor_gap linear_solver"
+    named = "enforcement mu eps0 ghost_penalty grid_refine num_gauss predictor_gap linear_solver"
     kw = {k: s[k] for k in named.split()}
     if s["band"] is not None:
         kw["band"] = s["band"]

@@ -16,7 +16,8 @@ in brackets; lengths and forces in the scene's units, angles in degrees):
       atol, stol, max_iterations, max_cutbacks}, predictor_gap [0], reinit_drift [0.2]
   [[bodies]]  name, shape (circle, ellipse, box, polygon: as scene_spec), law = {type =
       "linear", E, nu} | {type = "orthotropic", ...} (small strain per step) | {type =
-      "neo-hookean", E, nu} (finite strain: F at the points, mpm/finite_strain.py)
+      "neo-hookean", E, nu} | {type = "j2", E, nu, yield_stress, hardening [0]} (finite
+      strain: F and the history at the points, mpm/finite_strain.py)
   [[obstacles]]  name, shape (any shape of scene_spec, half_plane included: normal outward
       from the obstacle), centre [the shape's centre; a half-plane's point; a polygon's
       vertex mean] (the point it turns about and its moment is taken about), bodies [every
@@ -60,7 +61,7 @@ from dolfinx_forms.app.spec_values import (
 )
 
 MAX_GRID_CELLS = 16_000_000  # 4000 x 4000
-MPM_LAWS = ("linear", "orthotropic", "neo-hookean")
+MPM_LAWS = ("linear", "orthotropic", "neo-hookean", "j2")
 MAX_STEPS = 100_000
 
 

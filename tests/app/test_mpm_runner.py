@@ -174,3 +174,23 @@ def test_plot_labels_from_the_scene_units():
     assert labels(spec) == {"xlabel": "x (mm)", "ylabel": "traction (N/mm^2)"}
     spec = load(SCENES / "patch.toml")
     assert labels(spec) == {"xlabel": "x", "ylabel": "traction"}
+
+
+def test_finite_strain_laws_and_the_augmented_lagrangian_from_a_file(tmp_path):
+    """A description's finite-strain laws (neo-hookean, j2) and solver.enforcement =
+    "augmented" reach the simulation: the nine-discs scene with its first disc's law replaced
+    runs with each; j2 is refused on the single-step path."""
+    for law, enforcement in (("{type='j2', E=1.0e5, nu=0.3, yield_stress=200.0}", "penalty"),
+                             ("{type='neo-hookean', E=1.0e5, nu=0.3}", "augmented")):
+        sets = ["checks=[]", f"bodies[0].law={law}", f"solver.enforcement='{enforcement}'",
+                "solver.eps0=0.01"]
+        out = tmp_path / enforcement
+        r = run(["-m", "dolfinx_forms", "run", SCENES / "nine_discs.toml",
+                 *[a for s in sets for a in ("--set", s)], "--out", out], tmp_path)  # fmt: skip
+        assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+        assert len(table(out / "steps.csv")) == 1
+        m = json.loads((out / "metrics.json").read_text())
+        assert m["solver"]["enforcement"] == enforcement, m["solver"].get("enforcement")
+    with pytest.raises(SpecError) as e:
+        load(SCENES / "hertz.toml", ["bodies[0].law={type='j2', E=1.0, nu=0.3, yield_stress=1.0}"])
+    assert e.value.key == "bodies[0].law.type" and "mpm" in str(e.value)
