@@ -131,6 +131,15 @@ class BulkForms:
             b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
             self.f_vectors.append(b)
 
+    def update_loads(self):
+        """Assemble the right-hand sides again (loads whose coefficients changed, e.g. the
+        Newmark inertia load of solvers/dynamics.py)."""
+        for (_, L), b in zip(self.rhs, self.f_vectors):
+            with b.localForm() as loc:
+                loc.set(0.0)
+            fem.petsc.assemble_vector(b, L)
+            b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
+
     def assemble_linear(self, K):
         """Add the linear part into K (its pattern must hold the mesh couplings), and explicit
         zeros on the cells of nonlinear bodies."""
