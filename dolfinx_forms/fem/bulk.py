@@ -68,7 +68,11 @@ class BulkForms:
         groups = {}
         for t, law in self.laws.items():
             groups.setdefault(law_key(law), (law, []))[1].append(t)
-        lin = [law.residual(u, v, measure(ts)) for law, ts in groups.values() if law.linear]
+        lin = [
+            law.residual(u, v, measure(ts, degree=getattr(law, "quadrature_degree", None)))
+            for law, ts in groups.values()
+            if law.linear
+        ]
         # a law whose coefficients live at quadrature points names their degree (the MPM's F_n)
         nl = [
             law.residual(u, v, measure(ts, True, getattr(law, "quadrature_degree", None)))

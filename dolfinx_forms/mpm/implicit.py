@@ -101,6 +101,7 @@ class ImplicitMPM:
         obstacles=(),
         dirichlet=(),
         reinit_drift=0.2,
+        dynamics=None,
         timer=None,
         log=print,
         **problem_kw,
@@ -139,6 +140,7 @@ class ImplicitMPM:
         self.obstacles = list(obstacles)
         self.dirichlet = list(dirichlet)
         self.reinit_drift = float(reinit_drift)
+        self.dynamics = dynamics  # None: quasi-static; a mpm.dynamics.PointNewmark
         self.timer = timer
         self.log = log if comm.rank == 0 else (lambda *a, **k: None)
         options(**problem_kw)  # an unknown option fails here, not at the first step
@@ -169,6 +171,7 @@ class ImplicitMPM:
             obstacles=[ob.state() for ob in self.obstacles],
             friction={k: tuple(a.copy() for a in v) for k, v in self.friction.items()},
             step_count=self.step_count,
+            time=None if self.dynamics is None else self.dynamics.time,
         )
 
     def restore(self, snap):
@@ -182,6 +185,8 @@ class ImplicitMPM:
             ob.set_state(s)
         self.friction = {k: tuple(a.copy() for a in v) for k, v in snap["friction"].items()}
         self.step_count = snap["step_count"]
+        if self.dynamics is not None:
+            self.dynamics.time = snap["time"]
 
     # ------------------------------------------------------------------ one step
     def step(self):
@@ -235,7 +240,7 @@ class ImplicitMPM:
             if self.points is not None and self.C:
                 sigma0 = self._project(scene, "stress", list(self.C), 3, mls_info)
             laws.update(self._finite_strain_laws(scene, mls_info))
-        loads = []
+            loads = [] if self.dynamics is None else self._inertia(scene, laws, mls_info)
         if sigma0 is not None:
             S = _stress_tensor(sigma0)
             loads.append(
@@ -263,6 +268,8 @@ class ImplicitMPM:
             for t, pts in self.points.items():
                 h0 = np.asarray(self.laws[t].initial_history, float)
                 pts.history = np.tile(h0, (len(pts), 1))
+                if self.dynamics is not None:
+                    pts.a = np.tile(self.dynamics.a0, (len(pts), 1))
         keys = problem.contact.names(scene)
         with self.phase("contact"):
             records.transfer_friction(self, problem, keys)
@@ -276,6 +283,8 @@ class ImplicitMPM:
             for b in self.bodies:
                 pts = self.points[b.tag]
                 du, grad, n_out = mp.displacement_at(problem, b.tag, pts.x, self.h)
+                if self.dynamics is not None:
+                    self.dynamics.update(pts, du)
                 if b.tag in self.point_laws:
                     mp.update_finite(pts, du, grad, self.point_laws[b.tag])
                 else:
@@ -289,6 +298,13 @@ class ImplicitMPM:
         for ob in self.obstacles:
             ob.advance(1.0)
         self.step_count += 1
+        if self.dynamics is not None:
+            self.dynamics.time += self.dynamics.dt
+            record["time"] = self.dynamics.time
+            record["kinetic_energy"] = {
+                b.name: self.dynamics.kinetic_energy(self.points[b.tag], self.dynamics.rho[b.tag])
+                for b in self.bodies
+            }
         self.problem, self.scene, self._key = problem, scene, key
         imap = problem.V.dofmap.index_map
         record.update(
@@ -419,7 +435,8 @@ class ImplicitMPM:
                 g = grad[out_] / np.linalg.norm(grad[out_], axis=1)[:, None]
                 targets[out_] -= phi[out_, None] * g
             pts = self.points[t]
-            values = np.ascontiguousarray(getattr(pts, field).reshape(len(pts), dim))
+            values = field(t, pts) if callable(field) else getattr(pts, field)
+            values = np.ascontiguousarray(values.reshape(len(pts), dim))
             r = _cpp.MLSProjector(pts.x, self.h).project(values, np.ascontiguousarray(targets))
             arr[qdofs[cells].ravel()] = r["values"]
             widened += int(np.sum(r["widening"] > 1))
@@ -428,6 +445,24 @@ class ImplicitMPM:
             self.log(f"MLS: {widened} integration points needed a wider support (reported)")
         info["widened"] += widened
         return q
+
+    def _inertia(self, scene, laws, info):
+        """Dynamics: v, a and the density projected from the points (at the step's start: zero
+        and rho_0), each law with its mass term (in place in `laws`), and the inertia and
+        gravity load (mpm/dynamics.py)."""
+        dyn, d = self.dynamics, 2
+        q, qd = self._quadrature_function(scene, 2 * d + 1, "kinematics")
+        arr = q.x.array.reshape(-1, 2 * d + 1)
+        for b in self.bodies:  # before the points exist: at rest, a = a0, rho_0
+            cells = scene.cell_tags.indices[scene.cell_tags.values == b.tag]
+            arr[qd[cells].ravel(), d : 2 * d] = dyn.a0
+            arr[qd[cells].ravel(), 2 * d] = dyn.rho[b.tag]
+        if self.points is not None:
+            values = lambda t, pts: dyn.point_values(pts, dyn.rho[t])  # noqa: E731
+            self._project(scene, values, [b.tag for b in self.bodies], 2 * d + 1, info, (q, qd),
+                          True)  # fmt: skip
+        laws.update(dyn.laws(laws, q, mp.DEGREE))
+        return [dyn.load(q, mp.DEGREE)]
 
     def _finite_strain_laws(self, scene, info):
         """{tag: fs.UpdatedLaw} of the finite-strain bodies: F_n and the history projected from

@@ -49,8 +49,14 @@ class MaterialPoints:
     stress: np.ndarray  # (n, 3) Cauchy [xx, yy, xy]
     F: np.ndarray = None  # (n, 2, 2) deformation gradient (identity when seeded)
     history: np.ndarray = None  # (n, k) the law's history (finite_strain.py)
+    v: np.ndarray = None  # (n, 2) velocity (dynamics.py; zero when seeded)
+    a: np.ndarray = None  # (n, 2) acceleration
 
     def __post_init__(self):
+        if self.v is None:
+            self.v = np.zeros_like(self.x)
+        if self.a is None:
+            self.a = np.zeros_like(self.x)
         if self.F is None:
             self.F = np.tile(np.eye(2), (len(self.vol0), 1, 1))
         if self.history is None:
@@ -62,7 +68,11 @@ class MaterialPoints:
     def copy(self):
         return MaterialPoints(
             self.tag,
-            *(a.copy() for a in (self.x, self.vol0, self.vol, self.stress, self.F, self.history)),
+            *(
+                a.copy()
+                for a in (self.x, self.vol0, self.vol, self.stress, self.F, self.history, self.v,
+                          self.a)
+            ),
         )
 
 

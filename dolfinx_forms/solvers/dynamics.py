@@ -33,10 +33,10 @@ INTEGRATORS = {  # name -> (beta, gamma)
 class Inertia(Law):
     """A body's law plus the Newmark mass term c0 rho int u . w (module docstring)."""
 
-    def __init__(self, law, rho, c0):
-        self.law, self.rho, self.c0 = law, float(rho), float(c0)
+    def __init__(self, law, rho, c0, degree=None):
+        self.law, self.rho, self.c0 = law, rho, float(c0)  # rho: a number or a UFL coefficient
         self.linear, self.modulus, self.p_modulus = law.linear, law.modulus, law.p_modulus
-        self.quadrature_degree = getattr(law, "quadrature_degree", None)
+        self.quadrature_degree = degree or getattr(law, "quadrature_degree", None)
 
     def residual(self, u, v, dx):
         return self.law.residual(u, v, dx) + self.c0 * self.rho * ufl.inner(u, v) * dx
@@ -48,7 +48,8 @@ class Inertia(Law):
         return self.law.cauchy(u)
 
     def describe(self):
-        return dict(self.law.describe(), rho=self.rho)
+        rho = self.rho if isinstance(self.rho, (int, float)) else "projected"
+        return dict(self.law.describe(), rho=rho)
 
 
 class Newmark:

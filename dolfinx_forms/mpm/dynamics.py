@@ -1,0 +1,71 @@
+"""Implicit Newmark dynamics on the material-point path (solvers/dynamics.py on a fixed mesh).
+
+The points carry velocity v and acceleration a. A step of length dt solves for the increment du
+on Omega_n with a_{n+1} = c0 (du - dt v_n) - c1 a_n (c0 = 1 / (beta dt^2), c1 = 1 / (2 beta) - 1),
+so the residual gains the mass term c0 int rho du . w (each body's law wrapped in
+`solvers.dynamics.Inertia`) and the load int rho (c0 dt v_n + c1 a_n + g) . w. v, a and the
+current density rho = rho_0 vol0 / vol reach the Gauss points of the new cells by the MLS
+projection (with the stress or F). After the step each point updates
+a <- c0 (du - dt v) - c1 a and v <- v + dt ((1 - gamma) a_n + gamma a_{n+1}) with du the
+converged increment at the point. Mass is rho_0 vol0 per point, constant.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import ufl
+
+from dolfinx_forms.fem.boundary import Load
+from dolfinx_forms.solvers.dynamics import INTEGRATORS, Inertia
+
+
+class PointNewmark:
+    """The Newmark rule of an ImplicitMPM (module docstring): rho {body tag: rho_0}, dt, the
+    integrator (a name of solvers.dynamics.INTEGRATORS or (beta, gamma)), gravity (a vector
+    per unit mass, any dimension)."""
+
+    def __init__(self, rho, dt, integrator="trapezoidal", gravity=(0.0, 0.0), a0=None):
+        self.rho = {int(t): float(r) for t, r in rho.items()}
+        if not all(r > 0 for r in self.rho.values()) or not dt > 0:
+            raise ValueError(f"dynamics: need rho > 0 and dt > 0, got {self.rho}, {dt}")
+        beta, gamma = INTEGRATORS[integrator] if isinstance(integrator, str) else integrator
+        self.dt, self.beta, self.gamma = float(dt), float(beta), float(gamma)
+        self.c0, self.c1 = 1.0 / (beta * dt**2), 1.0 / (2.0 * beta) - 1.0
+        self.gravity = np.asarray(gravity, float)
+        # the points' acceleration when seeded: gravity's (exact for a body in free fall)
+        self.a0 = self.gravity if a0 is None else np.asarray(a0, float)
+        self.time = 0.0
+
+    @staticmethod
+    def point_values(points, rho0):
+        """(n, 2 d + 1): [v, a, current density] of a body's points (the MLS columns)."""
+        rho = rho0 * points.vol0 / points.vol
+        return np.concatenate([points.v, points.a, rho[:, None]], axis=1)
+
+    def laws(self, laws, q, degree):
+        """Each body's law with the mass term c0 rho_q du . w (q: the projected columns at
+        the Gauss points of `degree`)."""
+        d = len(self.gravity)
+        made, out = {}, {}
+        for t, law in laws.items():
+            made.setdefault(id(law), Inertia(law, q[2 * d], self.c0, degree))
+            out[t] = made[id(law)]
+        return out
+
+    def load(self, q, degree):
+        """int rho_q (c0 dt v_q + c1 a_q + g) . w over all bodies (scale 1)."""
+        d = len(self.gravity)
+        v, a = ufl.as_vector([q[i] for i in range(d)]), ufl.as_vector([q[d + i] for i in range(d)])
+        g = ufl.as_vector([float(c) for c in self.gravity])
+        f = q[2 * d] * (self.c0 * self.dt * v + self.c1 * a + g)
+        return Load(lambda w, measure: ufl.inner(f, w) * measure(None, degree=degree),
+                    scale=lambda lam: 1.0)  # fmt: skip
+
+    def update(self, points, du):
+        """a and v of the points from the converged increment du (n, d); in place."""
+        a_new = self.c0 * (du - self.dt * points.v) - self.c1 * points.a
+        points.v = points.v + self.dt * ((1.0 - self.gamma) * points.a + self.gamma * a_new)
+        points.a = a_new
+
+    def kinetic_energy(self, points, rho0):
+        return 0.5 * float(np.sum(rho0 * points.vol0 * np.sum(points.v**2, axis=1)))
