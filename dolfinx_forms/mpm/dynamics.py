@@ -3,7 +3,8 @@
 The points carry velocity v and acceleration a. A step of length dt solves for the increment du
 on Omega_n with a_{n+1} = c0 (du - dt v_n) - c1 a_n (c0 = 1 / (beta dt^2), c1 = 1 / (2 beta) - 1),
 so the residual gains the mass term c0 int rho du . w (each body's law wrapped in
-`solvers.dynamics.Inertia`) and the load int rho (c0 dt v_n + c1 a_n + g) . w. v, a and the
+`solvers.dynamics.Inertia`) and the load int rho (c0 dt v_n + c1 a_n + g) . w. Optional
+damping: a viscous stress 2 eta sym grad (du / dt), which a rigid translation does not feel. v, a and the
 current density rho = rho_0 vol0 / vol reach the Gauss points of the new cells by the MLS
 projection (with the stress or F). After the step each point updates
 a <- c0 (du - dt v) - c1 a and v <- v + dt ((1 - gamma) a_n + gamma a_{n+1}) with du the
@@ -24,7 +25,8 @@ class PointNewmark:
     integrator (a name of solvers.dynamics.INTEGRATORS or (beta, gamma)), gravity (a vector
     per unit mass, any dimension)."""
 
-    def __init__(self, rho, dt, integrator="trapezoidal", gravity=(0.0, 0.0), a0=None):
+    def __init__(self, rho, dt, integrator="trapezoidal", gravity=(0.0, 0.0), a0=None,
+                 viscosity=0.0):  # fmt: skip
         self.rho = {int(t): float(r) for t, r in rho.items()}
         if not all(r > 0 for r in self.rho.values()) or not dt > 0:
             raise ValueError(f"dynamics: need rho > 0 and dt > 0, got {self.rho}, {dt}")
@@ -34,6 +36,11 @@ class PointNewmark:
         self.gravity = np.asarray(gravity, float)
         # the points' acceleration when seeded: gravity's (exact for a body in free fall)
         self.a0 = self.gravity if a0 is None else np.asarray(a0, float)
+        # Kelvin-Voigt damping: a viscous stress 2 viscosity sym grad (du / dt) on the step's
+        # increment (no force for a rigid translation: rigid motions are not damped)
+        if not viscosity >= 0:
+            raise ValueError(f"dynamics: need viscosity >= 0, got {viscosity}")
+        self.viscosity = float(viscosity)
         self.time = 0.0
 
     @staticmethod
@@ -48,7 +55,9 @@ class PointNewmark:
         d = len(self.gravity)
         made, out = {}, {}
         for t, law in laws.items():
-            made.setdefault(id(law), Inertia(law, q[2 * d], self.c0, degree))
+            made.setdefault(
+                id(law), Inertia(law, q[2 * d], self.c0, degree, self.viscosity / self.dt)
+            )
             out[t] = made[id(law)]
         return out
 

@@ -31,15 +31,22 @@ INTEGRATORS = {  # name -> (beta, gamma)
 
 
 class Inertia(Law):
-    """A body's law plus the Newmark mass term c0 rho int u . w (module docstring)."""
+    """A body's law plus the Newmark mass term c0 rho int u . w (module docstring) and, with
+    viscous > 0, the damping term viscous int 2 sym grad u : grad w (the material point path's
+    Kelvin-Voigt damping on the step's increment, mpm/dynamics.py: zero for a rigid
+    translation, second order in a rigid rotation's angle)."""
 
-    def __init__(self, law, rho, c0, degree=None):
+    def __init__(self, law, rho, c0, degree=None, viscous=0.0):
         self.law, self.rho, self.c0 = law, rho, float(c0)  # rho: a number or a UFL coefficient
+        self.viscous = float(viscous)
         self.linear, self.modulus, self.p_modulus = law.linear, law.modulus, law.p_modulus
         self.quadrature_degree = degree or getattr(law, "quadrature_degree", None)
 
     def residual(self, u, v, dx):
-        return self.law.residual(u, v, dx) + self.c0 * self.rho * ufl.inner(u, v) * dx
+        r = self.law.residual(u, v, dx) + self.c0 * self.rho * ufl.inner(u, v) * dx
+        if self.viscous > 0:
+            r += self.viscous * 2 * ufl.inner(ufl.sym(ufl.grad(u)), ufl.grad(v)) * dx
+        return r
 
     def stress(self, u):
         return self.law.stress(u)
