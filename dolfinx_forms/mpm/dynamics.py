@@ -4,9 +4,10 @@ The points carry velocity v and acceleration a. A step of length dt solves for t
 on Omega_n with a_{n+1} = c0 (du - dt v_n) - c1 a_n (c0 = 1 / (beta dt^2), c1 = 1 / (2 beta) - 1),
 so the residual gains the mass term c0 int rho du . w (each body's law wrapped in
 `solvers.dynamics.Inertia`) and the load int rho (c0 dt v_n + c1 a_n + g) . w. Optional
-damping: a viscous stress 2 eta sym grad (du / dt), which a rigid translation does not feel. v, a and the
-current density rho = rho_0 vol0 / vol reach the Gauss points of the new cells by the MLS
-projection (with the stress or F). After the step each point updates
+damping: a viscous stress 2 eta sym grad (du / dt), which a rigid translation does not feel.
+v, a and the current density rho = rho_0 vol0 / vol reach the Gauss points of the new cells by
+the MLS projection (with the stress or F). `advance` controls the step size (a failed step is
+undone and done again at half the step; the step grows back). After the step each point updates
 a <- c0 (du - dt v) - c1 a and v <- v + dt ((1 - gamma) a_n + gamma a_{n+1}) with du the
 converged increment at the point. Mass is rho_0 vol0 per point, constant.
 """
@@ -31,8 +32,8 @@ class PointNewmark:
         if not all(r > 0 for r in self.rho.values()) or not dt > 0:
             raise ValueError(f"dynamics: need rho > 0 and dt > 0, got {self.rho}, {dt}")
         beta, gamma = INTEGRATORS[integrator] if isinstance(integrator, str) else integrator
-        self.dt, self.beta, self.gamma = float(dt), float(beta), float(gamma)
-        self.c0, self.c1 = 1.0 / (beta * dt**2), 1.0 / (2.0 * beta) - 1.0
+        self.beta, self.gamma = float(beta), float(gamma)
+        self.set_dt(dt)
         self.gravity = np.asarray(gravity, float)
         # the points' acceleration when seeded: gravity's (exact for a body in free fall)
         self.a0 = self.gravity if a0 is None else np.asarray(a0, float)
@@ -42,6 +43,43 @@ class PointNewmark:
             raise ValueError(f"dynamics: need viscosity >= 0, got {viscosity}")
         self.viscosity = float(viscosity)
         self.time = 0.0
+
+    def set_dt(self, dt):
+        """The time step of the next steps (c0, c1 with it)."""
+        self.dt = float(dt)
+        self.c0, self.c1 = 1.0 / (self.beta * self.dt**2), 1.0 / (2.0 * self.beta) - 1.0
+
+    def advance(self, sim, t_end, dt_min=None, grow_after=4, log=print):
+        """Steps of sim (an ImplicitMPM with this rule) to time t_end with step-size control:
+        a step that fails (ContactSolverError, RuntimeError: the simulation is restored to the
+        state before it, points, level sets, friction and multiplier records, time) is done
+        again at half the time step, down to dt_min (default dt / 64); after grow_after
+        accepted steps the step doubles again, up to the dt given at construction. Yields
+        each accepted step's record; ContactSolverError when dt_min fails."""
+        from dolfinx_forms.solvers.newton import ContactSolverError
+
+        dt_max, good = self.dt, 0
+        dt_min = dt_max / 64 if dt_min is None else float(dt_min)
+        while self.time < t_end - 1e-12 * max(1.0, abs(t_end)):
+            self.set_dt(min(self.dt, t_end - self.time))
+            try:
+                record = sim.step()
+            except (ContactSolverError, RuntimeError) as e:
+                if self.dt / 2 < dt_min * (1 - 1e-12):
+                    raise ContactSolverError(
+                        f"t = {self.time:.6g}: the step failed down to dt = {self.dt:.3g} "
+                        f"(dt_min {dt_min:.3g}): {e}"
+                    ) from e
+                self.set_dt(self.dt / 2)
+                good = 0
+                log(f"t = {self.time:.6g}: step failed, dt halved to {self.dt:.4g} ({e})")
+                continue
+            record["dt"] = self.dt
+            good += 1
+            if good >= grow_after and self.dt < dt_max:
+                self.set_dt(min(2 * self.dt, dt_max))
+                good = 0
+            yield record
 
     @staticmethod
     def point_values(points, rho0):
