@@ -113,7 +113,9 @@ class DemoParser(argparse.ArgumentParser):
         if hasattr(a, "multiplier_mass") and a.enforcement == "augmented":
             from dolfinx_forms.geometry.pairs import DEFAULT_MULTIPLIER_MASS
 
-            a.multiplier_mass = a.multiplier_mass or DEFAULT_MULTIPLIER_MASS
+            # the multi-step path's default is the lumped projection (mpm/implicit.py)
+            default = "lumped" if getattr(self, "_multi_step", False) else DEFAULT_MULTIPLIER_MASS
+            a.multiplier_mass = a.multiplier_mass or default
         if (
             getattr(a, "enforcement", None) == "augmented"
             and hasattr(a, "eps0")
@@ -445,7 +447,7 @@ def demo_parser(
     if cells is not None:
         add_cells(p, *cells)
     if petsc:
-        add_enforcement(p, enforcement, multiplier_mass=not multi_step)
+        add_enforcement(p, enforcement)
         add_linear_solver(p)
         add_petsc(p)
     return p
@@ -504,7 +506,7 @@ def check_mpm_eps0(parser, args):
         )
 
 
-def add_enforcement(parser, choices=("penalty", "augmented"), multiplier_mass=True):
+def add_enforcement(parser, choices=("penalty", "augmented")):
     """--enforcement: penalty (eqs 8, 12) or augmented Lagrangian (Uzawa, seed 003); a demo of
     the multi-step MPM offers MPM_ENFORCEMENT."""
     parser.add_argument(
@@ -519,7 +521,7 @@ def add_enforcement(parser, choices=("penalty", "augmented"), multiplier_mass=Tr
             else "contact enforcement: the multi-step MPM runs the penalty only"
         ),
     )
-    if "augmented" in choices and multiplier_mass:  # the MPM's multipliers are point-wise
+    if "augmented" in choices:
         from dolfinx_forms.geometry.pairs import DEFAULT_MULTIPLIER_MASS, MULTIPLIER_MASSES
 
         parser.add_argument(

@@ -143,6 +143,10 @@ class ImplicitMPM:
         self.dynamics = dynamics  # None: quasi-static; a mpm.dynamics.PointNewmark
         self.timer = timer
         self.log = log if comm.rank == 0 else (lambda *a, **k: None)
+        if problem_kw.get("enforcement") == "augmented":
+            # the lumped projection of the multipliers: with the hybrid one (the single-step
+            # default) the grain assembly's Newton cycles from its second step on
+            problem_kw.setdefault("multiplier_mass", "lumped")
         options(**problem_kw)  # an unknown option fails here, not at the first step
         self.problem_kw = problem_kw
         # the contact band (the largest initial gap Gamma_c covers): the given one or 2 h to
