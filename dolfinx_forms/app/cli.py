@@ -518,7 +518,7 @@ def add_enforcement(parser, choices=("penalty", "augmented")):
             "(augmented Lagrangian, P1 multipliers along the contact: --eps0 sets only the "
             f"loop's speed, default {defaults.TUNING.augmented_eps0:g} with it)"
             if "augmented" in choices
-            else "contact enforcement: the multi-step MPM runs the penalty only"
+            else "contact enforcement"
         ),
     )
     if "augmented" in choices:

@@ -21,7 +21,7 @@ them) and returns, on every rank, one line per failed check:
   (penalty): a/2, 6 nodes body-fitted (4 cut), a +9.2 % (+2.7 %), p(x) 8.0 % (6.4 %); a/3, 8
   (6) nodes, a +6.3 % (+1.2 %), p(x) 4.3 % (5.9 %); a/4, 11 (7) nodes, a +3.8 %, p(x) 3.4 %
   (4.5 %). A column of discs (R = 10, h = 0.5, contacts ~0.7 h wide; tried in the multi-step
-  MPM, which runs the penalty only): half-widths 0.62-0.75 against the stiff penalty's
+  MPM before it offered the augmented Lagrangian): half-widths 0.62-0.75 against the stiff penalty's
   0.33-0.35, the force 9-18 % low.
 
 * unheld body: a rigid motion of a body (a translation, or the rotation about its centre) that
