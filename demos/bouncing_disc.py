@@ -23,17 +23,14 @@ import numpy as np
 if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNotFoundError
     sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
              "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
-import dolfinx_forms as df
 from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
 from dolfinx_forms.app.mpm_run import Steps
 from dolfinx_forms.fem.laws import NeoHookean
-from dolfinx_forms.geometry.obstacles import RigidObstacle
-from dolfinx_forms.mesh.cut_scene import half_plane
-from dolfinx_forms.mesh.grid_scene import grid_scene, uniform_lines
 from dolfinx_forms.mpm.dynamics import PointNewmark
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
 from dolfinx_forms.solvers.dynamics import INTEGRATORS
+from meshes.mpm import cylinder_on_floor
 
 # fmt: off
 OPTIONS = [  # option, kind, default[, help]
@@ -99,15 +96,10 @@ def evaluate(run, weight):
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
     with Run("bouncing_disc", vars(args), discretization="cut", plot=False) as run:
-        # the scene: the disc drop above the floor y < 0
-        R, h = args.R, args.h
-        xl = uniform_lines(-R - 3 * h, R + 3 * h, h)
-        yl = uniform_lines(-3 * h, 2 * R + args.drop + 3 * h, h) + 0.5 * h
-        floor = RigidObstacle("floor", half_plane((0.0, 0.0), (0.0, 1.0), 100 * R),
-                              bbox=[[-100 * R, -R], [100 * R, 0.0]])  # fmt: skip
-        box = np.array([[[xl[0], yl[0]], [xl[-1], yl[-1]]]])
-        scene = grid_scene(run.comm, xl, yl, [("disc", 1)], contact_box=box)
-        body = MPMBody("disc", 1, NeoHookean(args.E, args.nu), df.Circle((0.0, R + args.drop), R))
+        # the scene: the disc `drop` above the floor y < 0
+        (xl, yl), (name, tag, shape), floor, scene = cylinder_on_floor(
+            run.comm, args.R, args.h, 0.0, args.drop, "disc")  # fmt: skip
+        body = MPMBody(name, tag, NeoHookean(args.E, args.nu), shape)
         dyn = PointNewmark({1: args.rho}, args.dt, args.integrator, gravity=(0.0, -args.g),
                            viscosity=args.viscosity)  # fmt: skip
         sim = ImplicitMPM(run.comm, (xl, yl), [body], scene, obstacles=[floor], dynamics=dyn,

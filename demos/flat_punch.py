@@ -28,6 +28,7 @@ from dolfinx_forms.app import cli
 from dolfinx_forms.app.demo import Run
 from dolfinx_forms.app.mpm_run import Steps
 from dolfinx_forms.app.mpm_runner import reach_force
+from dolfinx_forms.contact.resultants import traction_vectors
 from dolfinx_forms.io.output import write_table
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
 from meshes.mpm import flat_punch
@@ -71,8 +72,7 @@ def tractions(sim):
     positive, p_t the tangential traction on the half-space along +x."""
     cs, rows = sim.problem.contact, []
     for g, s in zip(cs.pairs, cs.committed):
-        t = s["tau_n"][:, None] * g.normals + s["tau_t"][:, None] * g.tangents
-        rows.append(np.stack([g.points[:, 0], -s["tau_n"], t[:, 0]], axis=1))
+        rows.append(np.stack([g.points[:, 0], -s["tau_n"], traction_vectors(g, s)[:, 0]], 1))
     rows = np.concatenate(sim.comm.gather(np.concatenate(rows or [np.zeros((0, 3))])) or [[]])
     return rows[np.argsort(rows[:, 0])] if sim.comm.rank == 0 else None
 

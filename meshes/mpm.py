@@ -297,17 +297,17 @@ def flat_punch(comm, a=1.0, h=0.05, radius=7.0):
     return (xl, yl), ("halfspace", 1, shape), punch, fixed, build
 
 
-def cylinder_on_floor(comm, R=1.0, h=0.1, travel=2.0):
-    """A cylinder of radius R resting on a rigid floor (the half-plane y < 0, touching at the
-    origin) with room to roll `travel` along +x. The incline is the floor with gravity turned
-    by theta (the demo's frame: x along the incline). Returns (grid lines, (name, tag, shape),
-    floor, build_scene); the cylinder's bottom lies mid-way between grid lines."""
+def cylinder_on_floor(comm, R=1.0, h=0.1, travel=2.0, drop=0.0, name="cylinder"):
+    """A cylinder of radius R `drop` above a rigid floor (the half-plane y < 0; drop 0: resting
+    on it, touching at the origin) with room to roll `travel` along +x. The incline is the floor
+    with gravity turned by theta (the rolling demo's frame: x along the incline). Returns (grid
+    lines, (name, tag, shape), floor, build_scene); the floor lies mid-way between grid lines."""
     xl = uniform_lines(-R - 3 * h, R + travel + 3 * h, h)
-    yl = uniform_lines(-3 * h, 2 * R + 3 * h, h) + 0.5 * h
+    yl = uniform_lines(-3 * h, 2 * R + drop + 3 * h, h) + 0.5 * h
     far = 100 * (R + travel)
     floor = RigidObstacle(
         "floor", half_plane((0.0, 0.0), (0.0, 1.0), far), bbox=[[-far, -R], [far, 0.0]]
     )
     box = np.array([[[xl[0], yl[0]], [xl[-1], yl[-1]]]])  # the contact, on one rank
-    build = grid_scene(comm, xl, yl, [("cylinder", 1)], contact_box=box)
-    return (xl, yl), ("cylinder", 1, df.Circle((0.0, R), R)), floor, build
+    build = grid_scene(comm, xl, yl, [(name, 1)], contact_box=box)
+    return (xl, yl), (name, 1, df.Circle((0.0, R + drop), R)), floor, build

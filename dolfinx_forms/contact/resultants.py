@@ -8,12 +8,17 @@ eq 37's contact term)."""
 import numpy as np
 
 
+def traction_vectors(g, state):
+    """(n, 2): the traction tau_n n + tau_t t per unit length on body i at each contact point
+    of pair geometry `g` (normals, tangents) in the kernel state `state` (tau_n, tau_t)."""
+    return state["tau_n"][:, None] * g.normals + state["tau_t"][:, None] * g.tangents
+
+
 def traction_resultant(g, state, side="i", points=None, centre=None):
     """(force (2,), moment) of the contact tractions of pair geometry `g` (weights, normals,
     tangents) in the kernel state `state` (tau_n, tau_t) on body `side` ("i" or "j"); the
     moment about `centre` with the tractions applied at `points` (default: zero moment)."""
-    t = (state["tau_n"][:, None] * g.normals + state["tau_t"][:, None] * g.tangents)
-    t = t * g.weights[:, None]
+    t = traction_vectors(g, state) * g.weights[:, None]
     if side == "j":
         t = -t
     force = np.array([t[:, 0].sum(), t[:, 1].sum()])  # column by column: the sums' order fixed

@@ -21,13 +21,9 @@ import numpy as np
 import ufl
 from dolfinx import fem
 
-from dolfinx_forms.fem.laws import Law
+from dolfinx_forms.fem.laws import Law, as_tensor
 
 CELLS = {"triangle": basix.CellType.triangle, "quadrilateral": basix.CellType.quadrilateral}
-
-
-def _as_tensor(q, d):
-    return ufl.as_matrix([[q[i * d + j] for j in range(d)] for i in range(d)])
 
 
 class HistoryLaw(Law):
@@ -60,7 +56,7 @@ class HistoryLaw(Law):
 
     def kinematics(self, u):
         F = ufl.Identity(self.d) + ufl.grad(u)
-        return F, F * ufl.inv(_as_tensor(self.Fn, self.d))
+        return F, F * ufl.inv(as_tensor(self.Fn, self.d))
 
     def stress(self, u):
         F, f = self.kinematics(u)

@@ -30,6 +30,13 @@ def lame(E, nu):
     return E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
 
 
+def as_tensor(q, d):
+    """The d x d matrix of a UFL vector q of d*d components, row-major: the layout of F_n and
+    the relative gradient at quadrature points and material points (fem/history.py,
+    mpm/finite_strain.py)."""
+    return ufl.as_matrix([[q[i * d + j] for j in range(d)] for i in range(d)])
+
+
 def strain(u):
     """Small strain eps(u) = sym grad u."""
     return ufl.sym(ufl.grad(u))

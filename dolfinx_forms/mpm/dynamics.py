@@ -18,7 +18,7 @@ import numpy as np
 import ufl
 
 from dolfinx_forms.fem.boundary import Load
-from dolfinx_forms.solvers.dynamics import INTEGRATORS, Inertia
+from dolfinx_forms.solvers.dynamics import INTEGRATORS, Inertia, coefficients, kinematics
 
 
 class PointNewmark:
@@ -47,7 +47,7 @@ class PointNewmark:
     def set_dt(self, dt):
         """The time step of the next steps (c0, c1 with it)."""
         self.dt = float(dt)
-        self.c0, self.c1 = 1.0 / (self.beta * self.dt**2), 1.0 / (2.0 * self.beta) - 1.0
+        self.c0, self.c1 = coefficients(self.beta, self.dt)
 
     def advance(self, sim, t_end, dt_min=None, grow_after=4, log=print):
         """Steps of sim (an ImplicitMPM with this rule) to time t_end with step-size control:
@@ -110,9 +110,7 @@ class PointNewmark:
 
     def update(self, points, du):
         """a and v of the points from the converged increment du (n, d); in place."""
-        a_new = self.c0 * (du - self.dt * points.v) - self.c1 * points.a
-        points.v = points.v + self.dt * ((1.0 - self.gamma) * points.a + self.gamma * a_new)
-        points.a = a_new
+        points.v, points.a = kinematics(du, points.v, points.a, self.dt, self.beta, self.gamma)
 
     def kinetic_energy(self, points, rho0):
         return 0.5 * float(np.sum(rho0 * points.vol0 * np.sum(points.v**2, axis=1)))

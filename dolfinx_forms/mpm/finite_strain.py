@@ -28,12 +28,7 @@ import ufl
 from dolfinx import fem, mesh as dmesh
 from mpi4py import MPI
 
-from dolfinx_forms.fem.laws import Law
-
-
-def as_tensor(q, d):
-    """The d x d matrix of a UFL vector q of d*d components (row-major)."""
-    return ufl.as_matrix([[q[i * d + j] for j in range(d)] for i in range(d)])
+from dolfinx_forms.fem.laws import Law, as_tensor
 
 
 def voigt(S, d):

@@ -30,6 +30,19 @@ INTEGRATORS = {  # name -> (beta, gamma)
 }
 
 
+def coefficients(beta, dt):
+    """(c0, c1) = (1 / (beta dt^2), 1 / (2 beta) - 1) of the Newmark rule (module docstring)."""
+    return 1.0 / (beta * dt**2), 1.0 / (2.0 * beta) - 1.0
+
+
+def kinematics(du, v, a, dt, beta, gamma):
+    """(v_{n+1}, a_{n+1}) of the Newmark rule from the step's increment du = u_{n+1} - u_n,
+    v_n and a_n (arrays, any layout; module docstring)."""
+    c0, c1 = coefficients(beta, dt)
+    a_new = c0 * (du - dt * v) - c1 * a
+    return v + dt * ((1.0 - gamma) * a + gamma * a_new), a_new
+
+
 class Inertia(Law):
     """A body's law plus the Newmark mass term c0 rho int u . w (module docstring) and, with
     viscous > 0, the damping term viscous int 2 sym grad u : grad w (the material point path's
@@ -76,7 +89,7 @@ class Newmark:
             raise ValueError(f"Newmark: need rho > 0 and dt > 0, got {self.rho}, {dt}")
         beta, gamma = INTEGRATORS[integrator] if isinstance(integrator, str) else integrator
         self.dt, self.beta, self.gamma = float(dt), float(beta), float(gamma)
-        self.c0, self.c1 = 1.0 / (beta * dt**2), 1.0 / (2.0 * beta) - 1.0
+        self.c0, self.c1 = coefficients(beta, dt)
         self.u_n = self.v = self.a = None  # Functions on the problem's space (`loads`)
         self.time, self.steps = 0.0, 0
 
@@ -140,9 +153,7 @@ class Newmark:
         problem.lam = 0.0  # the step's own ramp (the committed u is the step's start)
         problem.solve(1, 1.0, label=label or f"t = {self.time + self.dt:.6g}")
         u, un, v, a = (f.x.array for f in (problem.u, self.u_n, self.v, self.a))
-        a_new = self.c0 * (u - un - self.dt * v) - self.c1 * a
-        v += self.dt * ((1.0 - self.gamma) * a + self.gamma * a_new)
-        a[:] = a_new
+        v[:], a[:] = kinematics(u - un, v, a, self.dt, self.beta, self.gamma)
         un[:] = u
         self.time += self.dt
         self.steps += 1

@@ -3,18 +3,13 @@ path) on a coarse grid: the disc comes to rest on the floor carrying its weight,
 or loss of contact; the bad-input contract."""
 
 import csv
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
+from demo_tests import assert_refused, load_demo
 
-_spec = importlib.util.spec_from_file_location(
-    "bouncing_disc", Path(__file__).resolve().parents[2] / "demos" / "bouncing_disc.py"
-)
-demo = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(demo)
+demo = load_demo("bouncing_disc")
 
 
 def test_comes_to_rest_on_the_floor(tmp_path):
@@ -45,8 +40,4 @@ def test_comes_to_rest_on_the_floor(tmp_path):
     ],
 )
 def test_bad_input_exits_2_naming_the_parameter(args, word, tmp_path, capsys):
-    with pytest.raises(SystemExit) as e:
-        demo.main(args + ["--out", str(tmp_path / "x")])
-    assert e.value.code == 2
-    assert word in capsys.readouterr().err
-    assert not (tmp_path / "x").exists()
+    assert_refused(demo, args, word, tmp_path, capsys)

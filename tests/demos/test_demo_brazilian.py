@@ -2,18 +2,13 @@
 its bad-input contract."""
 
 import csv
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
+from demo_tests import assert_refused, load_demo
 
-_spec = importlib.util.spec_from_file_location(
-    "brazilian_disc", Path(__file__).resolve().parents[2] / "demos" / "brazilian_disc.py"
-)
-demo = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(demo)
+demo = load_demo("brazilian_disc")
 
 
 def test_coarse_run_writes_the_contract(tmp_path):
@@ -53,11 +48,7 @@ def test_coarse_run_writes_the_contract(tmp_path):
     ],
 )
 def test_bad_input_exits_2_naming_the_parameter(args, word, tmp_path, capsys):
-    with pytest.raises(SystemExit) as e:
-        demo.main(args + ["--out", str(tmp_path / "x")])
-    assert e.value.code == 2
-    assert word in capsys.readouterr().err
-    assert not (tmp_path / "x").exists()
+    assert_refused(demo, args, word, tmp_path, capsys)
 
 
 def test_time_series_read_by_meshio_and_h5py(tmp_path):

@@ -2,17 +2,12 @@
 Johnson's, frictionless and adhesive, its files, and the bad-input contract."""
 
 import csv
-import importlib.util
 import json
-from pathlib import Path
 
 import pytest
+from demo_tests import assert_refused, load_demo
 
-_spec = importlib.util.spec_from_file_location(
-    "flat_punch", Path(__file__).resolve().parents[2] / "demos" / "flat_punch.py"
-)
-demo = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(demo)
+demo = load_demo("flat_punch")
 
 
 @pytest.mark.parametrize("mu", ["0", "inf"])
@@ -50,8 +45,4 @@ def test_tractions_against_johnson(mu, tmp_path):
     ],
 )
 def test_bad_input_exits_2_naming_the_parameter(args, word, tmp_path, capsys):
-    with pytest.raises(SystemExit) as e:
-        demo.main(args + ["--out", str(tmp_path / "x")])
-    assert e.value.code == 2
-    assert word in capsys.readouterr().err
-    assert not (tmp_path / "x").exists()
+    assert_refused(demo, args, word, tmp_path, capsys)

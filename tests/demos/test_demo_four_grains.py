@@ -2,20 +2,15 @@
 every body and the four contacts of every grain; the scene's overlaps; the bad-input contract."""
 
 import csv
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from meshes.four_grains import grain_outlines, overlap
+from demo_tests import assert_refused, load_demo
 
-_spec = importlib.util.spec_from_file_location(
-    "four_grains", Path(__file__).resolve().parents[2] / "demos" / "four_grains.py"
-)
-demo = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(demo)
+demo = load_demo("four_grains")
 
 
 def test_every_contact_starts_with_the_overlap():
@@ -90,8 +85,4 @@ def test_coarse_run_writes_the_contract(tmp_path):
     ],
 )
 def test_bad_input_exits_2_naming_the_parameter(args, word, tmp_path, capsys):
-    with pytest.raises(SystemExit) as e:
-        demo.main(args + ["--out", str(tmp_path / "x")])
-    assert e.value.code == 2
-    assert word in capsys.readouterr().err
-    assert not (tmp_path / "x").exists()
+    assert_refused(demo, args, word, tmp_path, capsys)

@@ -3,19 +3,14 @@ a coarse grid: the fitted acceleration and the rotation against the rigid cylind
 and slipping; a free fall exact; the bad-input contract."""
 
 import csv
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 from mpi4py import MPI
+from demo_tests import assert_refused, load_demo
 
-_spec = importlib.util.spec_from_file_location(
-    "rolling_cylinder", Path(__file__).resolve().parents[2] / "demos" / "rolling_cylinder.py"
-)
-demo = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(demo)
+demo = load_demo("rolling_cylinder")
 COARSE = ["--h", "0.2", "--dt", "0.1", "--t-end", "2", "--series-every", "20"]
 
 
@@ -74,8 +69,4 @@ def test_free_fall_is_exact():
     ],
 )
 def test_bad_input_exits_2_naming_the_parameter(args, word, tmp_path, capsys):
-    with pytest.raises(SystemExit) as e:
-        demo.main(args + ["--out", str(tmp_path / "x")])
-    assert e.value.code == 2
-    assert word in capsys.readouterr().err
-    assert not (tmp_path / "x").exists()
+    assert_refused(demo, args, word, tmp_path, capsys)
