@@ -14,17 +14,6 @@
 
 namespace contact {
 
-double quadratic_spline_weight(double r) {
-  r = std::abs(r);
-  if (r <= 0.5)
-    return 0.75 - r * r;
-  if (r < 1.5) {
-    const double s = 1.5 - r;
-    return 0.5 * s * s;
-  }
-  return 0.0;
-}
-
 namespace {
 
 /// nanoflann dataset adaptor over the projector's own copy of the sources.
@@ -95,6 +84,18 @@ template <int N> double invert_first_column(std::array<double, N * N> M, std::ar
   return std::isfinite(rc) ? rc : 0.0;
 }
 
+/// sum_q x_q y_q (y null: sum_q x_q) with four partial sums.
+double sum_product(const double* x, const double* y, std::size_t n) {
+  std::array<double, 4> s{};
+  std::size_t q = 0;
+  for (; q + 4 <= n; q += 4)
+    for (int l = 0; l < 4; ++l)
+      s[l] += y ? x[q + l] * y[q + l] : x[q + l];
+  for (; q < n; ++q)
+    s[0] += y ? x[q] * y[q] : x[q];
+  return (s[0] + s[1]) + (s[2] + s[3]);
+}
+
 bool all_finite(std::span<const double> a) {
   for (double v : a)
     if (!std::isfinite(v))
@@ -121,6 +122,21 @@ struct MLSProjector::Impl {
                std::span<const double> targets, MLSResult& out) const;
 };
 
+/// The sources of one target as contiguous arrays (the loops over them vectorise): index,
+/// offset (x_p - x_t) / H per axis (or coordinates, for a run's candidates), squared offset
+/// length, weight.
+template <int D> struct Support {
+  std::vector<std::uint32_t> id;
+  std::array<std::vector<double>, D> dx, wdx;
+  std::vector<double> r2, w;
+  void clear() {
+    id.clear();
+    for (auto& a : dx)
+      a.clear();
+    r2.clear();
+  }
+};
+
 template <int D>
 void MLSProjector::Impl::project(double h, const MLSOptions& opt, std::span<const double> values,
                                  std::size_t m, std::span<const double> targets,
@@ -129,73 +145,164 @@ void MLSProjector::Impl::project(double h, const MLSOptions& opt, std::span<cons
   const std::size_t k = targets.size() / D;
   const Tree<D>& index = tree<D>();
   const nanoflann::SearchParams unsorted(32, 0.0f, false);
-  // Buffers reused over all targets: the radius search result and the weights of its hits.
-  std::vector<std::pair<std::uint32_t, double>> hits;
-  std::vector<double> w;
-  hits.reserve(256);
-  w.reserve(256);
+  std::vector<std::pair<std::uint32_t, double>> hits; // radius-search result (index, d^2)
+  hits.reserve(1024);
+  Support<D> cand, sup, wide; // a run's candidates (coordinates), one target's support
+  std::vector<double> r2;
 
-  for (std::size_t t = 0; t < k; ++t) {
-    const double* xt = targets.data() + D * t;
-    double widen = 1.0;
-    for (int level = 0;; ++level, widen *= opt.widen_factor) {
-      const double H = h * widen;
-      index.radiusSearch(xt, 2.25 * H * H, hits, unsorted); // squared radius (1.5 H)^2
-      // Moment matrix (eq 42) on the basis P = [1, (x - x_t)/H] centred at the target.
-      std::array<double, N * N> M{};
-      w.resize(hits.size());
-      std::int32_t count = 0;
-      for (std::size_t q = 0; q < hits.size(); ++q) {
-        w[q] = quadratic_spline_weight(std::sqrt(hits[q].second) / H);
-        if (!(w[q] > 0))
-          continue;
-        ++count;
-        const double* xp = cloud.x.data() + D * std::size_t(hits[q].first);
-        std::array<double, N> P;
-        P[0] = 1.0;
-        for (int a = 0; a < D; ++a)
-          P[a + 1] = (xp[a] - xt[a]) / H;
-        for (int i = 0; i < N; ++i)
-          for (int j = 0; j <= i; ++j)
-            M[i * N + j] += w[q] * P[i] * P[j];
-      }
-      for (int i = 0; i < N; ++i)
-        for (int j = i + 1; j < N; ++j)
-          M[i * N + j] = M[j * N + i];
-
-      std::array<double, N> c{};
-      const double rc = count >= N ? invert_first_column<N>(M, c) : 0.0;
-      if (rc >= opt.rcond_min) {
-        // Eq 44 at x = x_t: u^h = e_0^T M^{-1} b = sum_p w_p (P_p . c) u_p, for all m fields.
-        double* u = out.values.data() + m * t;
-        for (std::size_t q = 0; q < hits.size(); ++q) {
-          if (!(w[q] > 0))
-            continue;
-          const double* xp = cloud.x.data() + D * std::size_t(hits[q].first);
-          double phi = c[0];
-          for (int a = 0; a < D; ++a)
-            phi += c[a + 1] * (xp[a] - xt[a]) / H;
-          phi *= w[q];
-          const double* up = values.data() + m * std::size_t(hits[q].first);
-          for (std::size_t f = 0; f < m; ++f)
-            u[f] += phi * up[f];
-        }
-        out.widening[t] = widen;
-        out.rcond[t] = rc;
-        out.neighbours[t] = count;
-        break;
-      }
-      if (level == opt.max_widenings) {
-        std::ostringstream msg;
-        msg << "MLSProjector::project: target " << t << " at (";
-        for (int a = 0; a < D; ++a)
-          msg << (a ? ", " : "") << xt[a];
-        msg << ") has a singular MLS fit (" << count << " neighbours, rcond " << rc
-            << ") even with the support widened to " << widen
-            << " h: the sources are too far or collinear there";
-        throw std::runtime_error(msg.str());
-      }
+  // The sources of target xt within 1.5 H among the candidates c: into sup.
+  auto select = [&](const double* xt, double H, const Support<D>& c) {
+    const std::size_t n = c.id.size();
+    const double inv = 1.0 / H;
+    r2.assign(n, 0.0);
+    for (int a = 0; a < D; ++a) {
+      const double* ca = c.dx[a].data();
+      const double xa = xt[a];
+      for (std::size_t j = 0; j < n; ++j)
+        r2[j] += (ca[j] - xa) * (ca[j] - xa) * (inv * inv);
     }
+    // branch-free compaction (about half the candidates are kept, unpredictably)
+    sup.id.resize(n);
+    sup.r2.resize(n);
+    for (auto& a : sup.dx)
+      a.resize(n);
+    std::uint32_t* __restrict id = sup.id.data();
+    double* __restrict rs = sup.r2.data();
+    std::array<double*, D> dx;
+    std::array<const double*, D> cx;
+    for (int a = 0; a < D; ++a)
+      dx[a] = sup.dx[a].data(), cx[a] = c.dx[a].data();
+    const std::uint32_t* cid = c.id.data();
+    const double* r2c = r2.data();
+    std::size_t kept = 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      id[kept] = cid[j];
+      rs[kept] = r2c[j];
+      for (int a = 0; a < D; ++a)
+        dx[a][kept] = (cx[a][j] - xt[a]) * inv;
+      kept += r2c[j] < 2.25;
+    }
+    sup.id.resize(kept);
+    sup.r2.resize(kept);
+    for (auto& a : sup.dx)
+      a.resize(kept);
+  };
+  // The sources of a radius search as candidates (their coordinates).
+  auto gather = [&](Support<D>& s, const std::vector<std::pair<std::uint32_t, double>>& found) {
+    s.clear();
+    for (const auto& hit : found) {
+      s.id.push_back(hit.first);
+      for (int a = 0; a < D; ++a)
+        s.dx[a].push_back(cloud.x[D * std::size_t(hit.first) + a]);
+    }
+  };
+
+  // The linear fit of eq 44 at target t on the support `sup`: writes the values and returns
+  // true, or false (rcond, count set) if the fit is singular.
+  auto fit = [&](std::size_t t, double& rc, std::int32_t& count) {
+    const std::size_t n = sup.id.size();
+    sup.w.resize(n);
+    double* __restrict w = sup.w.data();
+    const double* __restrict r2q = sup.r2.data();
+    for (std::size_t q = 0; q < n; ++q)
+      w[q] = quadratic_spline_weight(std::sqrt(r2q[q]));
+    // Moment matrix (eq 42) on the basis P = [1, (x - x_t)/H] centred at the target, entry by
+    // entry as sums over contiguous arrays (four partial sums each: no dependency chain)
+    for (int a = 0; a < D; ++a) {
+      sup.wdx[a].resize(n);
+      for (std::size_t q = 0; q < n; ++q)
+        sup.wdx[a][q] = w[q] * sup.dx[a][q];
+    }
+    std::array<double, N * N> M{};
+    M[0] = sum_product(w, nullptr, n);
+    for (int a = 0; a < D; ++a) {
+      M[(a + 1) * N] = sum_product(sup.wdx[a].data(), nullptr, n);
+      for (int b = 0; b <= a; ++b)
+        M[(a + 1) * N + b + 1] = sum_product(sup.wdx[a].data(), sup.dx[b].data(), n);
+    }
+    count = 0;
+    for (std::size_t q = 0; q < n; ++q)
+      count += w[q] > 0;
+    for (int i = 0; i < N; ++i)
+      for (int j = i + 1; j < N; ++j)
+        M[i * N + j] = M[j * N + i];
+    std::array<double, N> c{};
+    rc = count >= N ? invert_first_column<N>(M, c) : 0.0;
+    if (!(rc >= opt.rcond_min))
+      return false;
+    // Eq 44 at x = x_t: u^h = e_0^T M^{-1} b = sum_p w_p (P_p . c) u_p, for all m fields.
+    double* u = out.values.data() + m * t;
+    for (std::size_t q = 0; q < n; ++q) {
+      double phi = c[0];
+      for (int a = 0; a < D; ++a)
+        phi += c[a + 1] * sup.dx[a][q];
+      phi *= sup.w[q];
+      const double* up = values.data() + m * std::size_t(sup.id[q]);
+      for (std::size_t f = 0; f < m; ++f)
+        u[f] += phi * up[f];
+    }
+    return true;
+  };
+
+  // Targets come in runs of close points (the Gauss points of one cell): one radius search
+  // of radius 1.5 h + the run's extent serves the whole run, each target then keeps the
+  // candidates within its own support: the sources of a search of its own, found faster.
+  constexpr std::size_t max_run = 64;
+  for (std::size_t t0 = 0; t0 < k;) {
+    const double* x0 = targets.data() + D * t0;
+    std::size_t t1 = t0 + 1;
+    for (; t1 < k and t1 - t0 < max_run; ++t1) {
+      const double* x1 = targets.data() + D * t1;
+      double d2 = 0;
+      for (int a = 0; a < D; ++a)
+        d2 += (x1[a] - x0[a]) * (x1[a] - x0[a]);
+      if (d2 > h * h)
+        break;
+    }
+    // one search about the run's centre, radius 1.5 h + the run's radius about it
+    std::array<double, D> centre{};
+    for (std::size_t t = t0; t < t1; ++t)
+      for (int a = 0; a < D; ++a)
+        centre[a] += targets[D * t + a] / double(t1 - t0);
+    double radius2 = 0;
+    for (std::size_t t = t0; t < t1; ++t) {
+      double d2 = 0;
+      for (int a = 0; a < D; ++a)
+        d2 += (targets[D * t + a] - centre[a]) * (targets[D * t + a] - centre[a]);
+      radius2 = std::max(radius2, d2);
+    }
+    const double R = 1.5 * h * (1 + 1e-12) + std::sqrt(radius2);
+    index.radiusSearch(centre.data(), R * R, hits, unsorted);
+    gather(cand, hits);
+    for (std::size_t t = t0; t < t1; ++t) {
+      const double* xt = targets.data() + D * t;
+      select(xt, h, cand);
+      double rc;
+      std::int32_t count;
+      double widen = 1.0;
+      // singular: widen the support (eq 45's h) and search again, up to the cap
+      for (int level = 0; not fit(t, rc, count); ++level) {
+        if (level == opt.max_widenings) {
+          std::ostringstream msg;
+          msg << "MLSProjector::project: target " << t << " at (";
+          for (int a = 0; a < D; ++a)
+            msg << (a ? ", " : "") << xt[a];
+          msg << ") has a singular MLS fit (" << count << " neighbours, rcond " << rc
+              << ") even with the support widened to " << widen
+              << " h: the sources are too far or collinear there";
+          throw std::runtime_error(msg.str());
+        }
+        widen *= opt.widen_factor;
+        const double H = h * widen;
+        index.radiusSearch(xt, 2.25 * H * H, hits, unsorted);
+        gather(wide, hits);
+        select(xt, H, wide);
+      }
+      out.widening[t] = widen;
+      out.rcond[t] = rc;
+      out.neighbours[t] = count;
+    }
+    t0 = t1;
   }
 }
 
