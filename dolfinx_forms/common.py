@@ -1,5 +1,6 @@
 """Small helpers shared by the library's sub-packages: MPI reductions of arrays, the running
-program's name (for one-line messages) and the error of a bad scene description."""
+program's name (for one-line messages), the threads a rank may use and the error of a bad scene
+description."""
 
 import os
 import sys
@@ -15,6 +16,22 @@ def program_name() -> str:
     if name == "__main__.py":
         return os.path.basename(os.path.dirname(os.path.abspath(arg0))) or "python3"
     return name if name and name not in ("-c", "-m") else "python3"
+
+
+def worker_threads(comm):
+    """Threads each rank gives its C++ loops over points (the MLS projection): ILS_THREADS if
+    set (>= 1), else this process's cores shared among the ranks (at least 1). Results do not
+    depend on it."""
+    env = os.environ.get("ILS_THREADS")
+    if env:
+        try:
+            n = int(env)
+        except ValueError:
+            n = 0
+        if n < 1:
+            raise ValueError(f"ILS_THREADS must be an integer >= 1, got {env!r}")
+        return n
+    return max(1, len(os.sched_getaffinity(0)) // comm.size)
 
 
 def allreduce_array(comm, a, op):

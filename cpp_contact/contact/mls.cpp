@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 
 namespace contact {
@@ -84,6 +86,30 @@ template <int N> double invert_first_column(std::array<double, N * N> M, std::ar
   return std::isfinite(rc) ? rc : 0.0;
 }
 
+/// Runs of consecutive close targets (within h of a run's first, at most 64: the Gauss points
+/// of one cell) as their first indices, k appended. A rule of the targets alone: the runs, and
+/// so the results bit for bit, do not depend on the number of threads.
+std::vector<std::size_t> run_starts(std::span<const double> targets, int dim, double h) {
+  const std::size_t k = targets.size() / std::size_t(dim), max_run = 64;
+  std::vector<std::size_t> starts;
+  for (std::size_t t0 = 0; t0 < k;) {
+    starts.push_back(t0);
+    std::size_t t1 = t0 + 1;
+    for (; t1 < k and t1 - t0 < max_run; ++t1) {
+      double d2 = 0;
+      for (int a = 0; a < dim; ++a) {
+        const double d = targets[dim * t1 + a] - targets[dim * t0 + a];
+        d2 += d * d;
+      }
+      if (d2 > h * h)
+        break;
+    }
+    t0 = t1;
+  }
+  starts.push_back(k);
+  return starts;
+}
+
 /// sum_q x_q y_q (y null: sum_q x_q) with four partial sums.
 double sum_product(const double* x, const double* y, std::size_t n) {
   std::array<double, 4> s{};
@@ -119,7 +145,8 @@ struct MLSProjector::Impl {
 
   template <int D>
   void project(double h, const MLSOptions& opt, std::span<const double> values, std::size_t m,
-               std::span<const double> targets, MLSResult& out) const;
+               std::span<const double> targets, std::span<const std::size_t> starts,
+               MLSResult& out) const;
 };
 
 /// The sources of one target as contiguous arrays (the loops over them vectorise): index,
@@ -140,9 +167,8 @@ template <int D> struct Support {
 template <int D>
 void MLSProjector::Impl::project(double h, const MLSOptions& opt, std::span<const double> values,
                                  std::size_t m, std::span<const double> targets,
-                                 MLSResult& out) const {
+                                 std::span<const std::size_t> starts, MLSResult& out) const {
   constexpr int N = D + 1;
-  const std::size_t k = targets.size() / D;
   const Tree<D>& index = tree<D>();
   const nanoflann::SearchParams unsorted(32, 0.0f, false);
   std::vector<std::pair<std::uint32_t, double>> hits; // radius-search result (index, d^2)
@@ -247,18 +273,8 @@ void MLSProjector::Impl::project(double h, const MLSOptions& opt, std::span<cons
   // Targets come in runs of close points (the Gauss points of one cell): one radius search
   // of radius 1.5 h + the run's extent serves the whole run, each target then keeps the
   // candidates within its own support: the sources of a search of its own, found faster.
-  constexpr std::size_t max_run = 64;
-  for (std::size_t t0 = 0; t0 < k;) {
-    const double* x0 = targets.data() + D * t0;
-    std::size_t t1 = t0 + 1;
-    for (; t1 < k and t1 - t0 < max_run; ++t1) {
-      const double* x1 = targets.data() + D * t1;
-      double d2 = 0;
-      for (int a = 0; a < D; ++a)
-        d2 += (x1[a] - x0[a]) * (x1[a] - x0[a]);
-      if (d2 > h * h)
-        break;
-    }
+  for (std::size_t r = 0; r + 1 < starts.size(); ++r) {
+    const std::size_t t0 = starts[r], t1 = starts[r + 1];
     // one search about the run's centre, radius 1.5 h + the run's radius about it
     std::array<double, D> centre{};
     for (std::size_t t = t0; t < t1; ++t)
@@ -302,7 +318,6 @@ void MLSProjector::Impl::project(double h, const MLSOptions& opt, std::span<cons
       out.rcond[t] = rc;
       out.neighbours[t] = count;
     }
-    t0 = t1;
   }
 }
 
@@ -343,7 +358,7 @@ std::size_t MLSProjector::num_points() const {
 }
 
 MLSResult MLSProjector::project(std::span<const double> values, std::size_t m,
-                                std::span<const double> targets) const {
+                                std::span<const double> targets, int threads) const {
   const std::size_t n = num_points();
   if (m < 1)
     throw std::invalid_argument("MLSProjector::project: values must have m >= 1 fields (columns)");
@@ -361,10 +376,33 @@ MLSResult MLSProjector::project(std::span<const double> values, std::size_t m,
   const std::size_t k = targets.size() / std::size_t(_dim);
   MLSResult out{std::vector<double>(k * m, 0.0), std::vector<double>(k), std::vector<double>(k),
                 std::vector<std::int32_t>(k)};
-  if (_dim == 2)
-    _impl->project<2>(_h, _options, values, m, targets, out);
-  else
-    _impl->project<3>(_h, _options, values, m, targets, out);
+  // the runs split over the threads in contiguous blocks; each thread writes its own targets
+  const std::vector<std::size_t> starts = run_starts(targets, _dim, _h);
+  const std::size_t runs = starts.size() - 1;
+  const std::size_t nt = std::clamp<std::size_t>(std::size_t(std::max(1, threads)), 1,
+                                                 std::max<std::size_t>(1, runs / 256));
+  std::vector<std::exception_ptr> errors(nt);
+  auto work = [&](std::size_t i) {
+    try {
+      const std::span<const std::size_t> mine(starts.data() + runs * i / nt,
+                                              runs * (i + 1) / nt - runs * i / nt + 1);
+      if (_dim == 2)
+        _impl->project<2>(_h, _options, values, m, targets, mine, out);
+      else
+        _impl->project<3>(_h, _options, values, m, targets, mine, out);
+    } catch (...) {
+      errors[i] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (std::size_t i = 1; i < nt; ++i)
+    pool.emplace_back(work, i);
+  work(0);
+  for (auto& th : pool)
+    th.join();
+  for (auto& e : errors) // the first failing target's error, whatever the thread count
+    if (e)
+      std::rethrow_exception(e);
   return out;
 }
 

@@ -94,12 +94,13 @@ public:
   /// @param[in] values Flattened (n, m) source values, row-major, finite
   /// @param[in] m Number of fields (>= 1)
   /// @param[in] targets Flattened (k, d) target coordinates, finite
+  /// @param[in] threads Threads sharing the targets (>= 1; the results do not depend on it)
   /// @return Values (k, m) and per target the widening factor, rcond and neighbour count
   /// @throws std::invalid_argument naming the argument for size mismatches or non-finite input
   /// @throws std::runtime_error naming the target index and coordinates if its fit is still
   /// singular at the widening cap (e.g. a target far from every source)
-  MLSResult project(std::span<const double> values, std::size_t m,
-                    std::span<const double> targets) const;
+  MLSResult project(std::span<const double> values, std::size_t m, std::span<const double> targets,
+                    int threads = 1) const;
 
 private:
   struct Impl;

@@ -1,6 +1,8 @@
 // Copyright (C) 2026 The ILS contact developers. SPDX-License-Identifier: MIT
-// Bindings of the point location on unstructured P1 meshes (triangles, quadrilaterals).
+// Bindings of the point location on unstructured P1 meshes (triangles, quadrilaterals), and
+// of the Q1 field evaluation at located points of grid cells.
 #include "array.h"
+#include <contact/grid_field.h>
 #include <contact/point_location.h>
 #include <numeric>
 #include <optional>
@@ -49,6 +51,37 @@ CellLocator make_locator(const py::object& x_in, const py::object& cells_in,
 } // namespace
 
 void bind_location(py::module_& m) {
+  m.def(
+      "q1_evaluate",
+      [](const py::object& u_in, const py::object& dofs_in, const py::object& X_in,
+         const py::object& extent_in) {
+        const char* f = "q1_evaluate";
+        const auto u = input<double>(Arg{f, "u"}, u_in, {any, any});
+        const auto X = input<double>(Arg{f, "X"}, X_in, {any, any});
+        const py::ssize_t n = X.shape(0), d = X.shape(1), bs = u.shape(1);
+        if (d != 2 and d != 3)
+          fail(Arg{f, "X"}, "expected (n, 2) or (n, 3), got " + contact::python::shape_str(X));
+        const auto extent = input<double>(Arg{f, "extent"}, extent_in, {n, d});
+        const Indices dofs(Arg{f, "dofs"}, dofs_in, {n, py::ssize_t(1) << d});
+        dofs.check_range(0, u.shape(0));
+        std::vector<double> out(std::size_t(n * bs * (1 + d)));
+        {
+          py::gil_scoped_release release;
+          q1_evaluate(flat(u), int(bs), dofs.flat(), flat(X), flat(extent), int(d), out);
+        }
+        py::dict r;
+        auto all = to_numpy(std::move(out), {n, bs * (1 + d)});
+        r["values"] = all[py::make_tuple(py::slice(0, n, 1), py::slice(0, bs, 1))];
+        r["grad"] = all[py::make_tuple(py::slice(0, n, 1), py::slice(bs, bs * (1 + d), 1))].attr(
+            "reshape")(n, bs, d);
+        return r;
+      },
+      py::arg("u"), py::arg("dofs"), py::arg("X"), py::arg("extent"),
+      "Value and gradient of a Q1 vector field u (num_dofs, bs) at n points of axis-aligned grid "
+      "cells: dofs (n, 2^d) of each point's cell in basix vertex order, X (n, d) reference "
+      "coordinates (extrapolated outside [0, 1]^d), extent (n, d) the cells' edge lengths. "
+      "Returns a dict: values (n, bs), grad (n, bs, d) with grad[:, c, a] = du_c / dx_a");
+
   py::class_<CellLocator>(
       m, "CellLocator",
       "Cells of one body of a P1 mesh (triangles or DOLFINx-ordered quadrilaterals), binned on a "

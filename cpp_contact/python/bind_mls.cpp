@@ -26,8 +26,8 @@ MLSProjector make_projector(const py::object& sources_in, double h, double rcond
   return MLSProjector(flat(sources), dim, h, MLSOptions{rcond_min, widen_factor, max_widenings});
 }
 
-py::dict project(const MLSProjector& mls, const py::object& values_in,
-                 const py::object& targets_in) {
+py::dict project(const MLSProjector& mls, const py::object& values_in, const py::object& targets_in,
+                 int threads) {
   const char* f = "MLSProjector.project";
   const auto n = py::ssize_t(mls.num_points());
   const auto values = input<double>(Arg{f, "values"}, values_in);
@@ -39,10 +39,12 @@ py::dict project(const MLSProjector& mls, const py::object& values_in,
   const auto targets = input<double>(Arg{f, "targets"}, targets_in, {any, mls.dim()});
   const auto x = flat(targets);
   const auto v = flat(values);
+  if (threads < 1)
+    fail(Arg{f, "threads"}, "must be >= 1, got " + std::to_string(threads));
   MLSResult r;
   {
     py::gil_scoped_release release;
-    r = mls.project(v, m, x);
+    r = mls.project(v, m, x, threads);
   }
   const auto k = py::ssize_t(r.widening.size());
   py::dict d;
@@ -85,8 +87,9 @@ void bind_mls(py::module_& m) {
       .def_property_readonly("num_points", &MLSProjector::num_points, "Number of sources n")
       .def_property_readonly("dim", &MLSProjector::dim, "Spatial dimension (2 or 3)")
       .def_property_readonly("h", &MLSProjector::h, "Support length h")
-      .def("project", &project, py::arg("values"), py::arg("targets"),
-           "Project values (n,) or (n, m) onto targets (k, d). Returns a dict: values (k,) or "
+      .def("project", &project, py::arg("values"), py::arg("targets"), py::arg("threads") = 1,
+           "Project values (n,) or (n, m) onto targets (k, d), on `threads` threads (the "
+           "results do not depend on it). Returns a dict: values (k,) or "
            "(k, m), widening (k,) support factor used (1 = none), rcond (k,) reciprocal 1-norm "
            "condition number of the scaled moment matrix, neighbours (k,) int32 sources with "
            "positive weight");

@@ -43,6 +43,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from dolfinx_forms import _cpp
+from dolfinx_forms.common import worker_threads
 from dolfinx_forms.mpm import material_points as mp
 from dolfinx_forms.fem.boundary import Load
 from dolfinx_forms.fem.cut import grid_cells
@@ -142,6 +143,7 @@ class ImplicitMPM:
         self.reinit_drift = float(reinit_drift)
         self.dynamics = dynamics  # None: quasi-static; a mpm.dynamics.PointNewmark
         self.timer = timer
+        self.threads = worker_threads(comm)
         self.log = log if comm.rank == 0 else (lambda *a, **k: None)
         if problem_kw.get("enforcement") == "augmented":
             # the lumped projection of the multipliers: with the hybrid one (the single-step
@@ -441,7 +443,9 @@ class ImplicitMPM:
             pts = self.points[t]
             values = field(t, pts) if callable(field) else getattr(pts, field)
             values = np.ascontiguousarray(values.reshape(len(pts), dim))
-            r = _cpp.MLSProjector(pts.x, self.h).project(values, np.ascontiguousarray(targets))
+            r = _cpp.MLSProjector(pts.x, self.h).project(
+                values, np.ascontiguousarray(targets), self.threads
+            )
             arr[qdofs[cells].ravel()] = r["values"]
             widened += int(np.sum(r["widening"] > 1))
         widened = self.comm.allreduce(widened, op=MPI.SUM)

@@ -332,16 +332,31 @@ def test_stick_predictor_shear_step():
     assert fx < 0 and fx == pytest.approx(slow["obstacles"]["top"]["fx"], rel=1e-8)
 
 
-def test_q1_basis_is_basix_q1():
-    """material_points.q1_basis (closed form, the points' displacement) against basix's Q1
-    element, values and first derivatives, inside the square and extrapolated outside."""
+@pytest.mark.parametrize("cell", ["quadrilateral", "hexahedron"])
+def test_q1_evaluate_is_basix_q1(cell):
+    """_cpp.q1_evaluate (the points' displacement and its gradient) against basix's Q1 element
+    on axis-aligned cells of random extents, inside the cell and extrapolated outside: values
+    and gradients of a random 2-component field to round-off."""
     import basix
 
-    from dolfinx_forms.mpm.material_points import q1_basis
+    from dolfinx_forms import _cpp
 
-    X = np.random.default_rng(0).uniform(-0.3, 1.3, (200, 2))
-    el = basix.create_element(basix.ElementFamily.P, basix.CellType.quadrilateral, 1)
-    assert np.abs(q1_basis(X) - el.tabulate(1, X)[:, :, :, 0]).max() < 1e-14
+    rng = np.random.default_rng(0)
+    d = 2 if cell == "quadrilateral" else 3
+    n, nv = 200, 2**d
+    el = basix.create_element(basix.ElementFamily.P, getattr(basix.CellType, cell), 1)
+    X = rng.uniform(-0.3, 1.3, (n, d))
+    e = rng.uniform(0.1, 2.0, (n, d))
+    u = rng.normal(size=(3 * nv, 2))
+    dofs = np.stack([rng.permutation(3 * nv)[:nv] for _ in range(n)]).astype(np.int32)
+    tab = el.tabulate(1, X)[:, :, :, 0]  # (1 + d, n, nv)
+    ref_u = np.einsum("pv,pvc->pc", tab[0], u[dofs])
+    ref_g = np.einsum("apv,pvc->pca", tab[1:], u[dofs]) / e[:, None, :]
+    r = _cpp.q1_evaluate(u, dofs, X, e)
+    assert np.abs(r["values"] - ref_u).max() < 1e-12
+    assert np.abs(r["grad"] - ref_g).max() < 1e-11
+    with pytest.raises(ValueError, match="dofs"):
+        _cpp.q1_evaluate(u, dofs + 3 * nv, X, e)
 
 
 def test_binned_mean_is_the_pixel_mean():
