@@ -289,6 +289,44 @@ def test_mls():
         mls.project(linear, np.zeros((10, 3)))
     with pytest.raises(ValueError, match="quadratic_spline_weight: r: expected float64, got int64"):
         _cpp.quadratic_spline_weight(np.arange(3))
+    with pytest.raises(ValueError, match=f + "threads: must be >= 1, got 0"):
+        mls.project(linear, tgt, 0)
+
+
+def test_mls_threads_bit_identical():
+    """The projection shares its targets among threads in runs fixed by the targets alone:
+    the values are the same bit for bit for 1, 2 and 3 threads (cell-ordered Gauss points,
+    as the MPM projects them)."""
+    rng = np.random.default_rng(4)
+    h = 0.025  # 1600 runs: enough for 3 threads (at least 256 runs each)
+    g, w = np.polynomial.legendre.leggauss(3)
+    g = 0.5 * (g + 1)
+    corners = np.stack(np.meshgrid(np.arange(0, 1, h), np.arange(0, 1, h)), -1).reshape(-1, 2)
+    gauss = np.stack(np.meshgrid(g, g), -1).reshape(-1, 2)
+    tgt = (corners[:, None] + h * gauss[None]).reshape(-1, 2)
+    src = tgt + rng.uniform(-0.2 * h, 0.2 * h, tgt.shape)
+    vals = rng.normal(size=(len(src), 3))
+    mls = _cpp.MLSProjector(src, h)
+    one = mls.project(vals, tgt, 1)
+    for n in (2, 3):
+        r = mls.project(vals, tgt, n)
+        assert np.array_equal(r["values"], one["values"])
+        assert np.array_equal(r["neighbours"], one["neighbours"])
+
+
+def test_worker_threads(monkeypatch):
+    from mpi4py import MPI
+
+    from dolfinx_forms.common import worker_threads
+
+    monkeypatch.setenv("ILS_THREADS", "3")
+    assert worker_threads(MPI.COMM_WORLD) == 3
+    for bad in ("0", "two"):
+        monkeypatch.setenv("ILS_THREADS", bad)
+        with pytest.raises(ValueError, match="ILS_THREADS must be an integer >= 1"):
+            worker_threads(MPI.COMM_WORLD)
+    monkeypatch.delenv("ILS_THREADS")
+    assert worker_threads(MPI.COMM_WORLD) >= 1
 
 
 def test_evolution():
