@@ -26,6 +26,7 @@ the reference configuration; Newton only changes u in the gaps (eqs 27-30). For 
    non-matching meshes.
 """
 
+import functools
 from dataclasses import dataclass
 
 import basix
@@ -462,6 +463,7 @@ def closest_points(body, phi, points, length_scale, exact=True):
     return _cpp.closest_point_projection(phi, points)
 
 
+@functools.lru_cache(maxsize=None)
 def _basix_element(cell_type, degree):
     cell = {"triangle": basix.CellType.triangle, "quadrilateral": basix.CellType.quadrilateral}[
         cell_type
@@ -498,6 +500,18 @@ class BodyLocator:
 NEIGHBOURS = [(0, 0)] + [(di, dj) for di in (0, -1, 1) for dj in (0, -1, 1) if di or dj]
 
 
+def grid_locator(scene, tag, degree=1, owned_only=False):
+    """The GridLocator of body `tag` of a cut scene, made once per scene (the pairs of a body
+    and the material-point update share it)."""
+    cache = scene.__dict__.setdefault("_grid_locators", {})
+    key = (int(tag), int(degree), bool(owned_only))
+    if key not in cache:
+        cache[key] = GridLocator(
+            scene.mesh, scene.cell_tags, tag, scene.cut, degree, owned_only=owned_only
+        )
+    return cache[key]
+
+
 class GridLocator:
     """Point location among one body's active cells of a cut scene's structured grid: the grid
     index of a point is found by bisection on the tensor lines and looked up in a table (no
@@ -510,16 +524,21 @@ class GridLocator:
 
     def __init__(self, mesh, cell_tags, tag, cut, degree, owned_only=False):
         self.xl, self.yl = np.asarray(cut.xlines), np.asarray(cut.ylines)
-        self.table = np.full((len(self.xl) - 1, len(self.yl) - 1), -1, np.int32)
         g = mesh.geometry.dofmap.array.reshape(-1, 4)
-        cells = cell_tags.indices[cell_tags.values == tag].astype(np.int32)
+        cells = cell_tags.find(tag).astype(np.int32)
         if owned_only:  # e.g. to take each point's value from one rank, partition-independently
             cells = cells[cells < mesh.topology.index_map(2).size_local]
         xv = mesh.geometry.x[g[cells], :2]  # (n, 4, 2)
         self.v0, self.ex, self.ey = xv[:, 0], xv[:, 1] - xv[:, 0], xv[:, 2] - xv[:, 0]
         centre = xv.mean(axis=1)
         i, j = self._index(centre)
-        self.table[i, j] = np.arange(len(cells), dtype=np.int32)
+        # the table covers the body's grid cells and a border of one empty cell (the 3 x 3
+        # neighbourhood of a point beyond it holds none of the body's cells): a body costs its
+        # own size, not the grid's
+        self.origin = (i.min() - 1, j.min() - 1) if len(cells) else (0, 0)
+        shape = (i.max() - i.min() + 3, j.max() - j.min() + 3) if len(cells) else (1, 1)
+        self.table = np.full(shape, -1, np.int32)
+        self.table[i - self.origin[0], j - self.origin[1]] = np.arange(len(cells), dtype=np.int32)
         self.cells, self.lo, self.hi = cells, xv.min(axis=1), xv.max(axis=1)
         self.element = _basix_element("quadrilateral", degree)
 
@@ -544,9 +563,12 @@ class GridLocator:
             n = len(p)
             return np.full(n, -1, np.int32), np.full((n, 2), np.nan), np.full(n, np.inf)
         i, j = self._index(p)
+        i, j = i - self.origin[0], j - self.origin[1]
         best = np.full(len(p), -1, np.int32)
         dist = np.full(len(p), np.inf)
-        rest = np.arange(len(p))  # the points not yet inside a cell (distance 0)
+        # the points not yet inside a cell (distance 0); none beyond the table's empty border
+        nxt, nyt = self.table.shape
+        rest = np.flatnonzero((i >= 0) & (i < nxt) & (j >= 0) & (j < nyt))
         for di, dj in NEIGHBOURS:  # own grid cell first; neighbours only where it is inactive
             ii = np.clip(i[rest] + di, 0, self.table.shape[0] - 1)
             jj = np.clip(j[rest] + dj, 0, self.table.shape[1] - 1)
@@ -721,7 +743,7 @@ class _Sides:
             None  # rigid side: no dofs, its motion is prescribed (u_j_prescribed)
             if body is obstacle
             else (
-                GridLocator(scene.mesh, scene.cell_tags, body.tag, cut, degree)
+                grid_locator(scene, body.tag, degree)
                 if cut is not None  # structured grid: O(1) location by index
                 else BodyLocator(scene.mesh, scene.cell_tags, body.tag, scene.cell_type, degree)
             )

@@ -33,7 +33,7 @@ from mpi4py import MPI
 from dolfinx_forms import _cpp
 from dolfinx_forms.common import allreduce_array
 from dolfinx_forms.fem.cut import CUT, shape_values
-from dolfinx_forms.geometry.pairs import GridLocator
+from dolfinx_forms.geometry.pairs import grid_locator
 
 DEGREE = 4  # 3x3 Gauss points per cell: the cut cells' rule (cut.CutIntegration)
 
@@ -167,7 +167,7 @@ def displacement_at(problem, tag, points, max_distance):
     comm = scene.mesh.comm
     # each rank's best owned cell, then the nearest over the ranks (ties: the lowest rank):
     # the same cell as on one rank whatever the partition
-    loc = GridLocator(scene.mesh, scene.cell_tags, tag, scene.cut, 1, owned_only=True)
+    loc = grid_locator(scene, tag, 1, owned_only=True)
     cells, X, outside = loc.locate(points, max_distance)
     best = allreduce_array(comm, outside, MPI.MIN)
     mine = (cells >= 0) & (outside == best)

@@ -140,12 +140,11 @@ def unheld_bodies(problem):
     for k, b in enumerate(bodies):
         nodes = np.unique(dofmap[problem.scene.cell_tags.find(b.tag)])
         body[nodes[nodes < n_own]] = k
-    count = comm.allreduce(np.bincount(body[body >= 0], minlength=nb), op=MPI.SUM)
-    sums = np.zeros((nb, 2))
-    np.add.at(sums, body[body >= 0], X[body >= 0])
+    held = body >= 0
+    count = comm.allreduce(np.bincount(body[held], minlength=nb), op=MPI.SUM)
+    sums = np.stack([np.bincount(body[held], X[held, a], nb) for a in range(2)], axis=1)
     centre = comm.allreduce(sums, op=MPI.SUM) / np.maximum(count, 1)[:, None]
     # R: a row per owned dof, the columns 3 k + (x, y, rotation) of its body k
-    held = body >= 0
     d = X - centre[np.maximum(body, 0)]
     vals = np.zeros((n_own, bs, 3))
     vals[:, 0, 0] = vals[:, 1, 1] = 1.0
@@ -191,8 +190,8 @@ def body_rfactors(ptr, cols, vals, num_bodies):
     Shape (num_bodies, 3, 3)."""
     row = np.repeat(np.arange(len(ptr) - 1), np.diff(ptr))
     key, inv = np.unique(row * num_bodies + cols // 3, return_inverse=True)
-    dense = np.zeros((len(key), 3))
-    np.add.at(dense, (inv.ravel(), cols % 3), vals)
+    # bincount: np.add.at's sums, in the same order, some 10x faster
+    dense = np.bincount(3 * inv.ravel() + cols % 3, vals, 3 * len(key)).reshape(-1, 3)
     return stacked_rfactors(dense, key % num_bodies, num_bodies)
 
 
