@@ -118,6 +118,23 @@ def grid_cells(X, Y, phi):
     return dict(points=pts, quads=quads, active=active, kinds=kinds, bbox=bbox)
 
 
+def material_window(phi):
+    """Node index bounds (i0, i1, j0, j1) of the sub-grid that holds every active cell of a
+    level set with node values phi (ny, nx): the nodes with phi < 0 and one more line on each
+    side (a cell is active when one of its vertices has phi < 0), within the grid; the whole
+    grid if no node is inside. Work on a body then costs its own size, not the grid's."""
+    ny, nx = phi.shape
+    rows, cols = np.flatnonzero((phi < 0).any(axis=1)), np.flatnonzero((phi < 0).any(axis=0))
+    if len(rows) == 0:
+        return 0, nx - 1, 0, ny - 1
+    return (
+        max(cols[0] - 1, 0),
+        min(cols[-1] + 1, nx - 1),
+        max(rows[0] - 1, 0),
+        min(rows[-1] + 1, ny - 1),
+    )
+
+
 def levelset_values(scene, V):
     """A Function on the scalar Q1 space V of scene.mesh holding at each dof the cut shape of the
     body owning it (the bodies are disjoint: every dof belongs to one body); ghosts updated."""

@@ -2,13 +2,16 @@
 
 `grid_scene(comm, xlines, ylines, bodies, ...)` returns the `build_scene(levelsets)` callback of
 `dolfinx_forms.mpm.implicit.ImplicitMPM`: every step it makes the cut scene of the current level
-sets (each body's window is the whole grid: only its level set decides its active cells).
+sets (each body's window is the sub-grid of its active cells, `fem.cut.material_window`: only
+its level set decides them, and a body's share of the build costs its size, not the grid's).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from dolfinx_forms import _cpp
+from dolfinx_forms.fem.cut import material_window
 from dolfinx_forms.mesh.cut_scene import CutBody, cut_scene
 
 
@@ -31,8 +34,17 @@ def grid_scene(comm, xlines, ylines, bodies, pairs=(), boundary_markers=None, co
     h = float(max(np.diff(xlines).max(), np.diff(ylines).max()))
     fixed = list(pairs)
 
+    def body_window(levelset):
+        """The grid-line window of a grid level set's active cells (`cut.material_window`)."""
+        if not isinstance(levelset, _cpp.LevelSet):
+            return window
+        i0, i1, j0, j1 = material_window(levelset.values)
+        return np.array([[xlines[i0], ylines[j0]], [xlines[i1], ylines[j1]]])
+
     def build(levelsets, pairs=None, boxes=None):
-        cbodies = [CutBody(name, tag, window, levelsets[tag]) for name, tag in bodies]
+        cbodies = [
+            CutBody(name, tag, body_window(levelsets[tag]), levelsets[tag]) for name, tag in bodies
+        ]
         use = fixed if pairs is None else [tuple(p) for p in pairs]
         box = contact_box if boxes is None else boxes
         return cut_scene(comm, xlines, ylines, cbodies, boundary_markers or {}, use, h, box)

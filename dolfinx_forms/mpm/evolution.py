@@ -16,22 +16,16 @@ def evolve(sim, problem, scene):
     xdof = V.tabulate_dof_coordinates()[:, :2]
     i = np.rint((xdof[:, 0] - sim.xlines[0]) / sim.h).astype(np.int64)
     j = np.rint((xdof[:, 1] - sim.ylines[0]) / sim.h).astype(np.int64)
-    node = i + nx * j
     owned = V.dofmap.index_map.size_local
     cell_dofs = V.dofmap.list.array.reshape(-1, 4)
     u = problem.u.x.array.reshape(-1, 2)
     out = dict(area_levelset={}, advection_substeps={}, reinitialized={}, gradient_drift={})
-    nn = sim.grid.num_nodes
     sim.grid_increments = {}
+    big = np.iinfo(np.int64).max
     for b in sim.bodies:
         dofs = np.unique(cell_dofs[scene.cell_tags.find(b.tag)])
         dofs = dofs[dofs < owned]
-        vel = np.zeros((nn, 2))
-        has = np.zeros(nn, np.int8)
-        vel[node[dofs]] = u[dofs]
-        has[node[dofs]] = 1
-        vel = allreduce_array(sim.comm, vel, MPI.SUM)
-        has = allreduce_array(sim.comm, has, MPI.MAX)
+        ib, jb = i[dofs], j[dofs]
         phi = sim.levelsets[b.tag]
         # known: every node of the body's active cells. The FE increment on the outside
         # nodes of cut cells is the unfitted method's own (smooth, ghost-penalised)
@@ -39,26 +33,34 @@ def evolve(sim, problem, scene):
         # eq 20 fills the rest of the grid. (Extending from the inside nodes only would move
         # the interface by du at a node up to h inside: first order, and the level set
         # would lag the material by ~ h grad(du) per step.)
-        known = (has > 0).reshape(ny, nx)
-        # a window of the grid around the body (its active nodes grown by 6 cells and the
+        # A window of the grid around the body (its known nodes grown by 6 cells and the
         # step's largest motion): a grain costs its own size, not the grid's. Beyond it the
         # level set keeps its (positive, far-field) values.
-        jj, ii = np.nonzero(known)
-        m = 6 + int(np.ceil(np.abs(vel).max() / sim.h))
-        i0, i1 = max(ii.min() - m, 0), min(ii.max() + m, nx - 1)
-        j0, j1 = max(jj.min() - m, 0), min(jj.max() + m, ny - 1)
+        n = len(dofs) > 0
+        lo = allreduce_array(
+            sim.comm, np.array([ib.min() if n else big, jb.min() if n else big]), MPI.MIN
+        )
+        hi = allreduce_array(
+            sim.comm, np.array([ib.max() if n else -1, jb.max() if n else -1]), MPI.MAX
+        )
+        umax = sim.comm.allreduce(float(np.abs(u[dofs]).max()) if n else 0.0, op=MPI.MAX)
+        m = 6 + int(np.ceil(umax / sim.h))
+        i0, i1 = max(lo[0] - m, 0), min(hi[0] + m, nx - 1)
+        j0, j1 = max(lo[1] - m, 0), min(hi[1] + m, ny - 1)
+        wx, wy = i1 - i0 + 1, j1 - j0 + 1
+        at = (jb - j0) * wx + (ib - i0)
+        v = np.zeros((wy * wx, 2))
+        known = np.zeros(wy * wx, np.int8)
+        v[at] = u[dofs]
+        known[at] = 1
+        v = allreduce_array(sim.comm, v, MPI.SUM)
+        known = allreduce_array(sim.comm, known, MPI.MAX)
         win = (slice(j0, j1 + 1), slice(i0, i1 + 1))
         sub = _cpp.StructuredGrid(sim.xlines[i0 : i1 + 1], sim.ylines[j0 : j1 + 1])
         values = phi.values  # (ny, nx) copy
-        v = vel.reshape(ny, nx, 2)[win].reshape(-1, 2)
-        v = _cpp.extend_normal(
-            sub,
-            values[win].ravel(),
-            known[win].ravel().astype(np.int8),
-            np.ascontiguousarray(v),
-        )
+        v = _cpp.extend_normal(sub, np.ascontiguousarray(values[win]).ravel(), known, v)
         full = np.zeros((ny, nx, 2))
-        full[win] = v.reshape(j1 - j0 + 1, i1 - i0 + 1, 2)
+        full[win] = v.reshape(wy, wx, 2)
         sim.grid_increments[b.name] = full.reshape(-1, 2)
         r = _cpp.advect_levelset(_cpp.LevelSet(sub, values[win].ravel()), v, 1.0, 0.5)
         new = r["levelset"]

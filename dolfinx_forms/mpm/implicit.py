@@ -46,7 +46,7 @@ from dolfinx_forms import _cpp
 from dolfinx_forms.common import worker_threads
 from dolfinx_forms.mpm import material_points as mp
 from dolfinx_forms.fem.boundary import Load
-from dolfinx_forms.fem.cut import grid_cells
+from dolfinx_forms.fem.cut import grid_cells, material_window
 from dolfinx_forms.fem.laws import as_law, law_key
 from dolfinx_forms.mpm import evolution, records
 from dolfinx_forms.mpm import finite_strain as fs
@@ -168,12 +168,10 @@ class ImplicitMPM:
         return nullcontext() if self.timer is None else self.timer.phase(name)
 
     def snapshot(self):
-        """Every piece of state a step changes (deep copies)."""
+        """Every piece of state a step changes (deep copies; the immutable level sets shared)."""
         return dict(
             points=None if self.points is None else {t: p.copy() for t, p in self.points.items()},
-            levelsets={
-                t: _cpp.LevelSet(self.grid, l.values.ravel()) for t, l in self.levelsets.items()
-            },
+            levelsets=dict(self.levelsets),  # LevelSets are immutable: shared, not copied
             obstacles=[ob.state() for ob in self.obstacles],
             friction={k: tuple(a.copy() for a in v) for k, v in self.friction.items()},
             step_count=self.step_count,
@@ -184,9 +182,7 @@ class ImplicitMPM:
         self.points = (
             None if snap["points"] is None else {t: p.copy() for t, p in snap["points"].items()}
         )
-        self.levelsets = {
-            t: _cpp.LevelSet(self.grid, l.values.ravel()) for t, l in snap["levelsets"].items()
-        }
+        self.levelsets = dict(snap["levelsets"])
         for ob, s in zip(self.obstacles, snap["obstacles"]):
             ob.set_state(s)
         self.friction = {k: tuple(a.copy() for a in v) for k, v in snap["friction"].items()}
@@ -353,8 +349,14 @@ class ImplicitMPM:
         `cut.grid_cells`), and the pairs; with the bodies' material boxes."""
         key, boxes = [tuple(pairs)], []
         for b in self.bodies:
-            g = grid_cells(self.xlines, self.ylines, self.levelsets[b.tag].values.ravel())
-            key += [g["active"].tobytes(), g["kinds"].tobytes()]
+            phi = self.levelsets[b.tag].values
+            i0, i1, j0, j1 = w = material_window(phi)  # grid_scene's window of the body
+            g = grid_cells(
+                self.xlines[i0 : i1 + 1],
+                self.ylines[j0 : j1 + 1],
+                np.ascontiguousarray(phi[j0 : j1 + 1, i0 : i1 + 1]).ravel(),
+            )
+            key += [w, g["active"].tobytes(), g["kinds"].tobytes()]
             boxes.append(g["bbox"])
         return key, boxes
 
