@@ -40,7 +40,7 @@ class BulkForms:
         self.u, self.V, self.scene = u, u.function_space, scene
         mesh = scene.mesh
         self.laws = {int(tag): as_law(m) for tag, m in laws.items()}
-        missing = set(int(t) for t in scene.cell_tags.values) - set(self.laws)
+        missing = set(np.unique(scene.cell_tags.values).tolist()) - set(self.laws)
         if missing:
             raise ValueError(f"materials: no law for body tag(s) {sorted(missing)}")
         self.integration = integration
