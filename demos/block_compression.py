@@ -134,7 +134,7 @@ def main(argv=None):
             rec, k = steps.step(), len(steps.rows) + 1
             steps.rows.append(dict(step=k, compression=k * args.compression / args.steps,
                 force=rec["obstacles"]["platen_top"]["fy"],
-                width=width_at(sim.levelsets[tag], *grid, 0.0),
+                width=width_at(sim.levelsets[tag], 0.0),
                 area_levelset=rec["area_levelset"]["block"],
                 volume_points=rec["volume_points"]["block"],
             ))  # fmt: skip

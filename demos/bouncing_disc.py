@@ -110,7 +110,7 @@ def main(argv=None):
         for _ in range(steps.num_steps):
             rec, p = steps.step(), sim.points[1]
             low = int(np.argmin(p.x[:, 1]))  # the lowest material point
-            phi = sim.levelsets[1].values.reshape(len(yl), len(xl))[:, np.argmin(np.abs(xl))]
+            phi = sim.levelset_values(1)[:, np.argmin(np.abs(xl))]
             k = int(np.argmax(phi <= 0))  # the contour's lowest crossing on x = 0
             gap = yl[k] - (yl[k] - yl[k - 1]) * phi[k] / (phi[k] - phi[k - 1]) if k else yl[0]
             steps.rows.append(dict(t=rec["time"], gap=float(gap), velocity=float(p.v[low, 1]),

@@ -259,10 +259,11 @@ def check_block(width, height, h, compression, steps):
         )
 
 
-def width_at(levelset, xlines, ylines, y):
-    """The extent of the zero contour of a grid level set along the grid line through y
+def width_at(levelset, y):
+    """The extent of the zero contour of a grid level set along its grid line through y
     (outermost sign changes, linear between nodes)."""
-    j = int(np.argmin(np.abs(np.asarray(ylines) - y)))
+    xlines, ylines = np.asarray(levelset.grid.x), np.asarray(levelset.grid.y)
+    j = int(np.argmin(np.abs(ylines - y)))
     phi = np.asarray(levelset.values).reshape(len(ylines), len(xlines))[j]
     inside = np.flatnonzero(phi <= 0)
     if len(inside) == 0:

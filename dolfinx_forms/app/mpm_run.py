@@ -121,9 +121,9 @@ def add_frames(sim, points_series, grid_series, step, x0):
     X, Y = np.meshgrid(sim.xlines, sim.ylines)
     v = (np.arange(ny - 1)[:, None] * nx + np.arange(nx - 1)[None, :]).ravel()
     quads = np.stack([v, v + 1, v + nx, v + nx + 1], axis=1)
-    data = {f"phi_{b.name}": sim.levelsets[b.tag].values.ravel() for b in sim.bodies}
-    for name, du in getattr(sim, "grid_increments", {}).items():
-        data[f"du_{name}"] = du
+    data = {f"phi_{b.name}": sim.levelset_values(b.tag).ravel() for b in sim.bodies}
+    for name in getattr(sim, "grid_increments", {}):
+        data[f"du_{name}"] = sim.grid_increment(name)
     grid_series.add(step, np.stack([X.ravel(), Y.ravel()], axis=1), data, quads)
 
 
@@ -285,7 +285,7 @@ def plot_force_chains(sim, record, path, title="force chains"):
     # the bodies' outlines (their level sets' zero contours) and the rigid obstacles'
     X, Y = np.meshgrid(sim.xlines, sim.ylines)
     for b in sim.bodies:
-        phi = np.asarray(sim.levelsets[b.tag].values).reshape(X.shape)
+        phi = sim.levelset_values(b.tag)
         ax.contour(X, Y, phi, [0.0], colors="tab:blue", linewidths=0.6)
     xy = np.c_[X.ravel(), Y.ravel()]
     for ob in getattr(sim, "obstacles", ()):

@@ -39,7 +39,8 @@ def grid_scene(comm, xlines, ylines, bodies, pairs=(), boundary_markers=None, co
         if not isinstance(levelset, _cpp.LevelSet):
             return window
         i0, i1, j0, j1 = material_window(levelset.values)
-        return np.array([[xlines[i0], ylines[j0]], [xlines[i1], ylines[j1]]])
+        x, y = np.asarray(levelset.grid.x), np.asarray(levelset.grid.y)  # lines of this grid
+        return np.array([[x[i0], y[j0]], [x[i1], y[j1]]])
 
     def build(levelsets, pairs=None, boxes=None):
         cbodies = [

@@ -26,7 +26,6 @@ def evolve(sim, problem, scene):
         dofs = np.unique(cell_dofs[scene.cell_tags.find(b.tag)])
         dofs = dofs[dofs < owned]
         ib, jb = i[dofs], j[dofs]
-        phi = sim.levelsets[b.tag]
         # known: every node of the body's active cells. The FE increment on the outside
         # nodes of cut cells is the unfitted method's own (smooth, ghost-penalised)
         # extension, second order at the interface; the constant normal extension of
@@ -47,6 +46,8 @@ def evolve(sim, problem, scene):
         m = 6 + int(np.ceil(umax / sim.h))
         i0, i1 = max(lo[0] - m, 0), min(hi[0] + m, nx - 1)
         j0, j1 = max(lo[1] - m, 0), min(hi[1] + m, ny - 1)
+        sim._grow(b.tag, (i0, i1, j0, j1))
+        phi, (a0, _, b0, _) = sim.levelsets[b.tag], sim.windows[b.tag]
         wx, wy = i1 - i0 + 1, j1 - j0 + 1
         at = (jb - j0) * wx + (ib - i0)
         v = np.zeros((wy * wx, 2))
@@ -55,13 +56,11 @@ def evolve(sim, problem, scene):
         known[at] = 1
         v = allreduce_array(sim.comm, v, MPI.SUM)
         known = allreduce_array(sim.comm, known, MPI.MAX)
-        win = (slice(j0, j1 + 1), slice(i0, i1 + 1))
-        sub = _cpp.StructuredGrid(sim.xlines[i0 : i1 + 1], sim.ylines[j0 : j1 + 1])
-        values = phi.values  # (ny, nx) copy
+        win = (slice(j0 - b0, j1 - b0 + 1), slice(i0 - a0, i1 - a0 + 1))  # in the body's window
+        sub = sim.subgrid((i0, i1, j0, j1))
+        values = phi.values  # the body's window, a copy
         v = _cpp.extend_normal(sub, np.ascontiguousarray(values[win]).ravel(), known, v)
-        full = np.zeros((ny, nx, 2))
-        full[win] = v.reshape(wy, wx, 2)
-        sim.grid_increments[b.name] = full.reshape(-1, 2)
+        sim.grid_increments[b.name] = ((i0, i1, j0, j1), v.reshape(wy, wx, 2))
         r = _cpp.advect_levelset(_cpp.LevelSet(sub, values[win].ravel()), v, 1.0, 0.5)
         new = r["levelset"]
         drift = float(_cpp.levelset_gradient_drift(new, 3 * sim.h))
@@ -70,7 +69,7 @@ def evolve(sim, problem, scene):
             new = _cpp.reinitialize(new)
         area = float(_cpp.levelset_area(new))
         values[win] = new.values
-        sim.levelsets[b.tag] = _cpp.LevelSet(sim.grid, values.ravel())
+        sim.levelsets[b.tag] = _cpp.LevelSet(phi.grid, values.ravel())
         out["area_levelset"][b.name] = area
         out["advection_substeps"][b.name] = int(r["substeps"])
         out["reinitialized"][b.name] = bool(redo)

@@ -129,14 +129,14 @@ class ImplicitMPM:
         self.point_laws = {
             t: point_laws[law_key(w)] for t, w in self.laws.items() if w.finite_strain
         }
-        self.levelsets = {}
+        # each body's level set lives on a window of the grid (grid-line indices (i0, i1, j0,
+        # j1)) that only grows (`_grow`): its nodes outside hold the initial shape's values,
+        # so a body costs its own size in time and memory, not the grid's
+        self.shapes = {b.tag: b.shape for b in self.bodies}
+        self.levelsets, self.windows = {}, {}
         for b in self.bodies:
-            if isinstance(b.shape, _cpp.LevelSet):
-                self.levelsets[b.tag] = _cpp.LevelSet(
-                    self.grid, b.shape.evaluate(self.grid.nodes())[0]
-                )
-            else:
-                self.levelsets[b.tag] = _cpp.levelset_from_shape(self.grid, b.shape)
+            self.windows[b.tag] = w = self._initial_window(b.shape)
+            self.levelsets[b.tag] = self._sample(b.shape, w)
         self.build_scene = build_scene
         self.obstacles = list(obstacles)
         self.dirichlet = list(dirichlet)
@@ -172,6 +172,7 @@ class ImplicitMPM:
         return dict(
             points=None if self.points is None else {t: p.copy() for t, p in self.points.items()},
             levelsets=dict(self.levelsets),  # LevelSets are immutable: shared, not copied
+            windows=dict(self.windows),
             obstacles=[ob.state() for ob in self.obstacles],
             friction={k: tuple(a.copy() for a in v) for k, v in self.friction.items()},
             step_count=self.step_count,
@@ -182,7 +183,7 @@ class ImplicitMPM:
         self.points = (
             None if snap["points"] is None else {t: p.copy() for t, p in snap["points"].items()}
         )
-        self.levelsets = dict(snap["levelsets"])
+        self.levelsets, self.windows = dict(snap["levelsets"]), dict(snap["windows"])
         for ob, s in zip(self.obstacles, snap["obstacles"]):
             ob.set_state(s)
         self.friction = {k: tuple(a.copy() for a in v) for k, v in snap["friction"].items()}
@@ -329,18 +330,105 @@ class ImplicitMPM:
         )
         return record
 
+    # ------------------------------------------------------------------ level-set windows
+    def subgrid(self, window):
+        """The grid's sub-grid of grid-line indices (i0, i1, j0, j1)."""
+        i0, i1, j0, j1 = window
+        return _cpp.StructuredGrid(self.xlines[i0 : i1 + 1], self.ylines[j0 : j1 + 1])
+
+    def _sample(self, shape, window):
+        """The level set of a shape (a `_cpp.Shape` or a grid LevelSet) sampled at the nodes of
+        a window."""
+        grid = self.subgrid(window)
+        if isinstance(shape, _cpp.LevelSet):
+            return _cpp.LevelSet(grid, shape.evaluate(grid.nodes())[0])
+        return _cpp.levelset_from_shape(grid, shape)
+
+    def _initial_window(self, shape, coarse=8, margin=8):
+        """A window holding the shape with `margin` cells around it: first from its values on
+        every `coarse`-th grid line (a signed distance: nodes within a coarse cell's diagonal of
+        the body mark it), widened until every node of the window's border is outside, then
+        cut to `margin` cells around its nodes inside. Any window gives the same answers (the
+        level set's values outside it are the shape's own, `_grow`): this one is small."""
+        nx, ny = len(self.xlines), len(self.ylines)
+        ci, cj = np.r_[0 : nx : coarse, nx - 1], np.r_[0 : ny : coarse, ny - 1]
+        X, Y = np.meshgrid(self.xlines[ci], self.ylines[cj])
+        P = np.ascontiguousarray(np.stack([X.ravel(), Y.ravel()], axis=1))
+        phi = (shape.evaluate(P)[0] if isinstance(shape, _cpp.LevelSet) else shape(P)).reshape(
+            X.shape
+        )
+        near = phi < np.sqrt(2) * coarse * self.h
+        if not near.any():
+            return 0, nx - 1, 0, ny - 1
+        rows, cols = np.flatnonzero(near.any(axis=1)), np.flatnonzero(near.any(axis=0))
+        w = [ci[cols[0]], ci[cols[-1]], cj[rows[0]], cj[rows[-1]]]
+        while True:
+            w = [max(w[0] - margin, 0), min(w[1] + margin, nx - 1)] + [
+                max(w[2] - margin, 0),
+                min(w[3] + margin, ny - 1),
+            ]
+            v = self._sample(shape, w).values
+            border = np.r_[v[0], v[-1], v[:, 0], v[:, -1]]
+            if border.min() > 0 or w == [0, nx - 1, 0, ny - 1]:
+                break
+        # then `margin` cells around the nodes inside, within it
+        rows, cols = np.flatnonzero((v < 0).any(axis=1)), np.flatnonzero((v < 0).any(axis=0))
+        if len(rows):
+            w = [
+                max(w[0] + cols[0] - margin, w[0]),
+                min(w[0] + cols[-1] + margin, w[1]),
+                max(w[2] + rows[0] - margin, w[2]),
+                min(w[2] + rows[-1] + margin, w[3]),
+            ]
+        return tuple(int(k) for k in w)
+
+    def _grow(self, tag, want):
+        """Widen body `tag`'s window to hold the window `want` (the new nodes: the initial
+        shape's values, as the whole-grid level set had there)."""
+        have = self.windows[tag]
+        new = (min(have[0], want[0]), max(have[1], want[1]), min(have[2], want[2]))
+        new = tuple(int(k) for k in new + (max(have[3], want[3]),))
+        if new == have:
+            return
+        values = self._sample(self.shapes[tag], new).values
+        values[
+            have[2] - new[2] : have[3] - new[2] + 1, have[0] - new[0] : have[1] - new[0] + 1
+        ] = self.levelsets[tag].values
+        self.levelsets[tag] = _cpp.LevelSet(self.subgrid(new), values.ravel())
+        self.windows[tag] = new
+
+    def levelset_values(self, tag):
+        """Body `tag`'s level set on the whole grid, (ny, nx): its window's values, and beyond
+        the window its largest value there (positive: the zero contour lies inside). For output
+        and plots."""
+        i0, i1, j0, j1 = self.windows[tag]
+        v = self.levelsets[tag].values
+        full = np.full((len(self.ylines), len(self.xlines)), max(float(v.max()), self.h))
+        full[j0 : j1 + 1, i0 : i1 + 1] = v
+        return full
+
+    def grid_increment(self, name):
+        """The last step's extended increment of body `name` on the whole grid (nx ny, 2):
+        zero beyond the window its level set was advected on (`evolution.evolve`)."""
+        (i0, i1, j0, j1), v = self.grid_increments[name]
+        full = np.zeros((len(self.ylines), len(self.xlines), 2))
+        full[j0 : j1 + 1, i0 : i1 + 1] = v
+        return full.reshape(-1, 2)
+
     # ------------------------------------------------------------------ parts
     def body_boxes(self):
         """(n, 2, 2) bounding box of each body's material: the grid nodes with phi <= 0, grown by
         one spacing (the zero contour lies within it)."""
-        X, Y = np.meshgrid(self.xlines, self.ylines)
         out = []
         for b in self.bodies:
+            i0, i1, j0, j1 = self.windows[b.tag]
             inside = self.levelsets[b.tag].values <= 0
             if not inside.any():
                 raise RuntimeError(f"body {b.name!r}: its level set has no node inside")
-            lo = np.array([X[inside].min(), Y[inside].min()]) - self.h
-            hi = np.array([X[inside].max(), Y[inside].max()]) + self.h
+            rows, cols = np.flatnonzero(inside.any(axis=1)), np.flatnonzero(inside.any(axis=0))
+            x, y = self.xlines[i0 : i1 + 1], self.ylines[j0 : j1 + 1]
+            lo = np.array([x[cols[0]], y[rows[0]]]) - self.h
+            hi = np.array([x[cols[-1]], y[rows[-1]]]) + self.h
             out.append([lo, hi])
         return np.array(out)
 
@@ -349,14 +437,15 @@ class ImplicitMPM:
         `cut.grid_cells`), and the pairs; with the bodies' material boxes."""
         key, boxes = [tuple(pairs)], []
         for b in self.bodies:
-            phi = self.levelsets[b.tag].values
-            i0, i1, j0, j1 = w = material_window(phi)  # grid_scene's window of the body
+            phi, (a0, _, b0, _) = self.levelsets[b.tag].values, self.windows[b.tag]
+            i0, i1, j0, j1 = material_window(phi)  # grid_scene's window of the body
             g = grid_cells(
-                self.xlines[i0 : i1 + 1],
-                self.ylines[j0 : j1 + 1],
+                self.xlines[a0 + i0 : a0 + i1 + 1],
+                self.ylines[b0 + j0 : b0 + j1 + 1],
                 np.ascontiguousarray(phi[j0 : j1 + 1, i0 : i1 + 1]).ravel(),
             )
-            key += [w, g["active"].tobytes(), g["kinds"].tobytes()]
+            key += [(a0 + i0, a0 + i1, b0 + j0, b0 + j1), g["active"].tobytes()]
+            key += [g["kinds"].tobytes()]
             boxes.append(g["bbox"])
         return key, boxes
 
@@ -374,7 +463,12 @@ class ImplicitMPM:
         band = self.band
         X, Y = np.meshgrid(self.xlines, self.ylines)
         P = np.stack([X.ravel(), Y.ravel()], axis=1)
-        near = {b.tag: self.levelsets[b.tag].values.ravel() < band for b in self.bodies}
+        near = {}
+        for b in self.bodies:  # beyond its window a body's level set is >= its margin (8 h)
+            i0, i1, j0, j1 = self.windows[b.tag]
+            m = np.zeros(X.shape, bool)
+            m[j0 : j1 + 1, i0 : i1 + 1] = self.levelsets[b.tag].values < band
+            near[b.tag] = m.ravel()
         keys, boxes = [], []
 
         def add(key, mask):

@@ -60,6 +60,46 @@ def test_rigid_translation_keeps_zero_stress_and_moves_points_exactly():
     assert np.max(np.abs(sim.levelsets[1].evaluate(ring)[0])) < 1e-3 * h
 
 
+def test_levelset_windows_follow_a_translated_disc():
+    """A small disc in a large grid: its level set lives on a window of the grid holding the
+    disc with an outside border (not the grid); translated by 3 h per step the window grows
+    along its path, keeps the old values where it overlaps and the initial shape's values on
+    its new nodes, and the whole-grid view (levelset_values, grid_increment) agrees with it."""
+    h, E, r = 0.1, 1000.0, 0.3
+    lines = uniform_lines(-6.0, 6.0, h)
+    d = np.array([0.3, 0.0])
+    everywhere = lambda x: np.ones(x.shape[1], bool)  # noqa: E731
+    bcs = [Dirichlet(everywhere, c, float(d[c])) for c in range(2)]
+    shape = df.Circle((-1.5, 0.0), r)
+    body = MPMBody("disc", 1, (E, 0.3), shape)
+    sim = ImplicitMPM(
+        COMM, (lines, lines), [body], grid_scene(COMM, lines, lines, [("disc", 1)]),
+        dirichlet=bcs, **quiet,
+    )
+    w0 = sim.windows[1]
+    v0 = sim.levelsets[1].values
+    assert v0.size < 0.1 * len(lines) ** 2  # a window, not the grid
+    assert min(v0[0].min(), v0[-1].min(), v0[:, 0].min(), v0[:, -1].min()) > 0
+    grid = sim.subgrid(w0)
+    assert np.array_equal(v0.ravel(), shape(grid.nodes()))  # sampled, as on the whole grid
+    for _ in range(3):
+        sim.step()
+    i0, i1, j0, j1 = sim.windows[1]
+    # grew along the motion (the last advection: 6 cells past the disc moved by 6 cells plus
+    # the 3 of its step), by the evolution's margin across it
+    assert i0 <= w0[0] and i1 >= w0[1] + 6 and j0 <= w0[2] and j1 >= w0[3]
+    assert (j1 - j0) - (w0[3] - w0[2]) <= 4
+    full = sim.levelset_values(1)
+    assert np.array_equal(full[j0 : j1 + 1, i0 : i1 + 1], sim.levelsets[1].values)
+    assert np.all(full[:, i1 + 1 :] > 0)
+    # the disc moved by 3 d: the contour follows it to the advection's accuracy
+    t = np.linspace(0, 2 * np.pi, 40)
+    ring = np.array([-1.5, 0.0]) + 3 * d + r * np.stack([np.cos(t), np.sin(t)], axis=1)
+    assert np.max(np.abs(sim.levelsets[1].evaluate(ring)[0])) < 0.05 * h
+    du = sim.grid_increment("disc").reshape(len(lines), len(lines), 2)
+    assert np.allclose(du[j0 : j1 + 1][np.abs(du[j0 : j1 + 1, :, 0]) > 0], d)
+
+
 def test_block_between_frictionless_platens_gives_the_uniaxial_force():
     """A block squeezed by rigid frictionless platens over 10 steps: plane-strain uniaxial
     stress, F = W E' d / (H + 2 E' eps_n) with E' = E / (1 - nu^2) (the penalty compliance of
