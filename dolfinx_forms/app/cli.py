@@ -30,11 +30,9 @@ class DefaultsFormatter(argparse.HelpFormatter):
 
     @staticmethod
     def _shows_default(action):
-        return (
-            bool(action.option_strings)
-            and action.nargs != 0
-            and action.default not in (None, [], argparse.SUPPRESS, "")
-        )
+        d = action.default  # may be an array: no == against the empty values
+        empty = d is None or d is argparse.SUPPRESS or (isinstance(d, (list, str)) and not d)
+        return bool(action.option_strings) and action.nargs != 0 and not empty
 
     def _format_action(self, action):
         if not action.help and self._shows_default(action):

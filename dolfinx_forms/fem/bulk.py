@@ -135,6 +135,12 @@ class BulkForms:
             b.ghostUpdate(PETSc.InsertMode.ADD, PETSc.ScatterMode.REVERSE)
             self.f_vectors.append(b)
 
+    def destroy(self):
+        """Free the PETSc vectors (petsc4py frees none when garbage-collected)."""
+        for b in self.f_vectors + ([self.b_nl] if self.nonlinear else []):
+            b.destroy()
+        self.f_vectors = []
+
     def update_loads(self):
         """Assemble the right-hand sides again (loads whose coefficients changed, e.g. the
         Newmark inertia load of solvers/dynamics.py)."""

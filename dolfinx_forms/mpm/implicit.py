@@ -204,6 +204,9 @@ class ImplicitMPM:
             try:
                 record = self._step()
             except Exception:
+                if getattr(self, "_pending", None) is not None:
+                    self._pending.destroy()
+                    self._pending = None
                 self.restore(snap)
                 raise
             if attempt == MAX_BAND_GROWTH or not self.band_reached():
@@ -273,6 +276,7 @@ class ImplicitMPM:
                 pts.history = np.tile(h0, (len(pts), 1))
                 if self.dynamics is not None:
                     pts.a = np.tile(self.dynamics.a0, (len(pts), 1))
+        self._pending = problem  # destroyed if the step fails (`step`)
         keys = problem.contact.names(scene)
         with self.phase("contact"):
             records.transfer_friction(self, problem, keys)
@@ -308,7 +312,9 @@ class ImplicitMPM:
                 b.name: self.dynamics.kinetic_energy(self.points[b.tag], self.dynamics.rho[b.tag])
                 for b in self.bodies
             }
-        self.problem, self.scene, self._key = problem, scene, key
+        if self.problem is not None and self.problem is not problem:
+            self.problem.destroy()  # petsc4py frees no PETSc object by itself
+        self.problem, self.scene, self._key, self._pending = problem, scene, key, None
         imap = problem.V.dofmap.index_map
         record.update(
             step=self.step_count,

@@ -43,6 +43,11 @@ class ForceControl:
         self.slope = float(guess) - self.s  # ds/dlam of the first step's prediction
         self.force, self.ds = self.start, 0.0
 
+    def destroy(self):
+        """Free the PETSc vectors (petsc4py frees none when garbage-collected)."""
+        for v in (self.sel, self.g, self.k, self.w):
+            v.destroy()
+
     def __call__(self, lam):  # the condition's value: the unknown, whatever the load level
         return self.s
 

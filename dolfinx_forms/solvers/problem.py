@@ -179,6 +179,18 @@ class ContactProblem:
         self.f = self.K.createVecLeft()
 
 
+    def destroy(self):
+        """Free this problem's PETSc objects: petsc4py frees none when garbage-collected, so a
+        run that makes a problem per step (the material-point path) calls this for each one it
+        drops. The problem is unusable afterwards."""
+        self.linear.destroy()
+        if self.control is not None:
+            self.control.destroy()
+            self.control = None
+        self.bulk.destroy()
+        linear.destroy(self.K, self.J, self.R, self.Ku, self.f)
+        self.K = self.J = self.R = self.Ku = self.f = None
+
     # ------------------------------------------------------------------ utilities
     @property
     def factorisations(self):
@@ -319,10 +331,12 @@ class ContactProblem:
         if failed:
             raise ContactSolverError(f"contact band {band:.4g}: rebuilding Gamma_c: {failed}")
         self.contact, self.pairs, self.band = new, new.pairs, band
-        with self.phase("assembly"):
-            self._matrices(self._rebuild["fem"].ghost_penalty)
         self.retired[0] = self.factorisations
         self.retired[1] = self.schur_factorisations
+        self.linear.destroy()
+        linear.destroy(self.K, self.J, self.R, self.Ku, self.f)
+        with self.phase("assembly"):
+            self._matrices(self._rebuild["fem"].ghost_penalty)
         so = self._rebuild["solver"]
         with self.phase("solve"):
             self.linear = linear.choose(self, so.linear_solver, so.petsc_options)

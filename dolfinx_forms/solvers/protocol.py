@@ -273,6 +273,7 @@ def _reach_in_newton(
     finally:
         problem.control = None
         bc.value = Path(control.s, control.s)
+        control.destroy()
     nsteps = len(problem.steps) - n0
     its = sum(s.iterations for s in problem.steps[n0:])
     force = problem.reaction(boundary)
