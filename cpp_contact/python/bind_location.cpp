@@ -3,6 +3,7 @@
 // of the Q1 field evaluation at located points of grid cells.
 #include "array.h"
 #include <contact/grid_field.h>
+#include <contact/grid_location.h>
 #include <contact/point_location.h>
 #include <numeric>
 #include <optional>
@@ -51,6 +52,45 @@ CellLocator make_locator(const py::object& x_in, const py::object& cells_in,
 } // namespace
 
 void bind_location(py::module_& m) {
+  py::class_<GridCellLocator>(m, "GridCellLocator",
+                              "Point location among one body's cells of a structured grid: "
+                              "bisection on the lines, a table over the body's cells")
+      .def(py::init([](const py::object& xl, const py::object& yl, const py::object& corners_in,
+                       const py::object& cells_in) {
+             const char* f = "GridCellLocator";
+             const auto x = input<double>(Arg{f, "xlines"}, xl, {any});
+             const auto y = input<double>(Arg{f, "ylines"}, yl, {any});
+             const auto corners = input<double>(Arg{f, "corners"}, corners_in, {any, 4, 2});
+             const Indices cells(Arg{f, "cells"}, cells_in, {corners.shape(0)});
+             return GridCellLocator(flat(x), flat(y), flat(corners), cells.flat());
+           }),
+           py::arg("xlines"), py::arg("ylines"), py::arg("corners"), py::arg("cells"),
+           "xlines, ylines: the grid lines; corners (n, 4, 2): each cell's vertices in DOLFINx "
+           "order; cells (n,): the index reported for each")
+      .def_property_readonly("num_cells", &GridCellLocator::num_cells)
+      .def(
+          "locate",
+          [](const GridCellLocator& loc, const py::object& points, double max_distance) {
+            const auto pts =
+                input<double>(Arg{"GridCellLocator.locate", "points"}, points, {any, 2});
+            const auto x = flat(pts);
+            LocatedPoints r;
+            {
+              py::gil_scoped_release release;
+              r = loc.locate(x, max_distance);
+            }
+            const auto n = py::ssize_t(r.cells.size());
+            py::dict d;
+            d["cells"] = to_numpy(std::move(r.cells), {n});
+            d["X"] = to_numpy(std::move(r.X), {n, 2});
+            d["outside"] = to_numpy(std::move(r.outside), {n});
+            return d;
+          },
+          py::arg("points"), py::arg("max_distance") = 0.0,
+          "Locate (n, 2) points: a dict of cells (int32, -1 if no cell of the 3 x 3 "
+          "neighbourhood is within max_distance), X (n, 2) reference coordinates (NaN there) "
+          "and outside (0 inside, else the distance to the cell; inf there)");
+
   m.def(
       "q1_evaluate",
       [](const py::object& u_in, const py::object& dofs_in, const py::object& X_in,

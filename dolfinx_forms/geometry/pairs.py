@@ -496,8 +496,6 @@ class BodyLocator:
         return self.element.tabulate(0, X)[0, :, :, 0]
 
 
-# the own grid cell first, then its 8 neighbours (GridLocator.locate)
-NEIGHBOURS = [(0, 0)] + [(di, dj) for di in (0, -1, 1) for dj in (0, -1, 1) if di or dj]
 
 
 def grid_locator(scene, tag, degree=1, owned_only=False):
@@ -513,14 +511,15 @@ def grid_locator(scene, tag, degree=1, owned_only=False):
 
 
 class GridLocator:
-    """Point location among one body's active cells of a cut scene's structured grid: the grid
-    index of a point is found by bisection on the tensor lines and looked up in a table (no
-    search over cells), so the cost per point is O(1) in the number of cells. A point in an
-    inactive grid cell (e.g. a closest point on the exact boundary where the straight cut
-    misses a sliver) goes to the nearest active cell of the 3 x 3 neighbourhood, with
-    extrapolated reference coordinates, if it is within max_distance of it. `locate` returns
-    (cells, X, outside) like BodyLocator: outside = 0 inside a cell, else the distance to it
-    (inf and cell -1 when nothing is within max_distance)."""
+    """Point location among one body's active cells of a cut scene's structured grid
+    (`_cpp.GridCellLocator`: the grid index of a point by bisection on the tensor lines, looked
+    up in a table over the body's cells, so the cost per point is O(1) in the number of cells
+    and the memory the body's size). A point in an inactive grid cell (e.g. a closest point on
+    the exact boundary where the straight cut misses a sliver) goes to the nearest active cell
+    of the 3 x 3 neighbourhood, with extrapolated reference coordinates, if it is within
+    max_distance of it. `locate` returns (cells, X, outside) like BodyLocator: outside = 0
+    inside a cell, else the distance to it (inf, cell -1 and X NaN when nothing is within
+    max_distance)."""
 
     def __init__(self, mesh, cell_tags, tag, cut, degree, owned_only=False):
         self.xl, self.yl = np.asarray(cut.xlines), np.asarray(cut.ylines)
@@ -528,18 +527,8 @@ class GridLocator:
         cells = cell_tags.find(tag).astype(np.int32)
         if owned_only:  # e.g. to take each point's value from one rank, partition-independently
             cells = cells[cells < mesh.topology.index_map(2).size_local]
-        xv = mesh.geometry.x[g[cells], :2]  # (n, 4, 2)
-        self.v0, self.ex, self.ey = xv[:, 0], xv[:, 1] - xv[:, 0], xv[:, 2] - xv[:, 0]
-        centre = xv.mean(axis=1)
-        i, j = self._index(centre)
-        # the table covers the body's grid cells and a border of one empty cell (the 3 x 3
-        # neighbourhood of a point beyond it holds none of the body's cells): a body costs its
-        # own size, not the grid's
-        self.origin = (i.min() - 1, j.min() - 1) if len(cells) else (0, 0)
-        shape = (i.max() - i.min() + 3, j.max() - j.min() + 3) if len(cells) else (1, 1)
-        self.table = np.full(shape, -1, np.int32)
-        self.table[i - self.origin[0], j - self.origin[1]] = np.arange(len(cells), dtype=np.int32)
-        self.cells, self.lo, self.hi = cells, xv.min(axis=1), xv.max(axis=1)
+        xv = np.ascontiguousarray(mesh.geometry.x[g[cells], :2])  # (n, 4, 2)
+        self.locator = _cpp.GridCellLocator(self.xl, self.yl, xv, cells)
         self.element = _basix_element("quadrilateral", degree)
 
     def _index(self, p):
@@ -555,46 +544,12 @@ class GridLocator:
         p = np.asarray(points, float)[:, :2]
         tie = 1e-9 * max(self.xl[-1] - self.xl[0], self.yl[-1] - self.yl[0])
         i, j = self._index(p - tie)
-        return i * self.table.shape[1] + j
+        return i * (len(self.yl) - 1) + j
 
     def locate(self, points, max_distance):
-        p = np.asarray(points, float)[:, :2]
-        if len(self.cells) == 0:  # none of the body's cells on this rank (owned_only)
-            n = len(p)
-            return np.full(n, -1, np.int32), np.full((n, 2), np.nan), np.full(n, np.inf)
-        i, j = self._index(p)
-        i, j = i - self.origin[0], j - self.origin[1]
-        best = np.full(len(p), -1, np.int32)
-        dist = np.full(len(p), np.inf)
-        # the points not yet inside a cell (distance 0); none beyond the table's empty border
-        nxt, nyt = self.table.shape
-        rest = np.flatnonzero((i >= 0) & (i < nxt) & (j >= 0) & (j < nyt))
-        for di, dj in NEIGHBOURS:  # own grid cell first; neighbours only where it is inactive
-            ii = np.clip(i[rest] + di, 0, self.table.shape[0] - 1)
-            jj = np.clip(j[rest] + dj, 0, self.table.shape[1] - 1)
-            k = self.table[ii, jj]
-            ok = k >= 0
-            d = np.full(len(rest), np.inf)
-            q = p[rest[ok]]
-            d[ok] = np.linalg.norm(
-                np.maximum(0, np.maximum(self.lo[k[ok]] - q, q - self.hi[k[ok]])), axis=1
-            )
-            better = d < dist[rest]
-            best[rest[better]], dist[rest[better]] = k[better], d[better]
-            rest = rest[dist[rest] > 0]  # a cell at distance 0 cannot be bettered
-        found = (best >= 0) & (dist <= max_distance)
-        k = np.where(found, best, 0)
-        r = p - self.v0[k]
-        X = np.stack(
-            [
-                np.einsum("ij,ij->i", r, self.ex[k])
-                / np.einsum("ij,ij->i", self.ex[k], self.ex[k]),
-                np.einsum("ij,ij->i", r, self.ey[k])
-                / np.einsum("ij,ij->i", self.ey[k], self.ey[k]),
-            ],
-            axis=1,
-        )
-        return np.where(found, self.cells[k], -1), X, np.where(found, dist, np.inf)
+        p = np.ascontiguousarray(np.asarray(points, float)[:, :2])
+        r = self.locator.locate(p, max_distance)
+        return r["cells"], r["X"], r["outside"]
 
     def basis(self, X):
         return self.element.tabulate(0, X)[0, :, :, 0]
