@@ -123,7 +123,7 @@ class RigidObstacle:
         # point plus the distance to the grid, continuous and positive there
         g = self.shape.grid
         lo, hi = np.array([g.x[0], g.y[0]]), np.array([g.x[-1], g.y[-1]])
-        Xc = np.clip(X, lo, hi)
+        Xc = np.minimum(np.maximum(X, lo), hi)  # np.clip: ~10 us of overhead a call
         return self.shape.evaluate(np.ascontiguousarray(Xc))[0] + np.linalg.norm(X - Xc, axis=1)
 
     def levelset(self, grid):

@@ -362,8 +362,9 @@ def multiplier_nodes(surface, kind, length, tol):
     nodes = np.full((len(x), 2), -1, np.int32)
     weights = np.zeros((len(x), 2))
     t = s / np.where(n_el[c] > 0, lengths[c] / np.maximum(n_el[c], 1), 1.0)
-    e = np.clip(np.floor(t), 0, np.maximum(n_el[c] - 1, 0)).astype(np.int64)
-    theta = np.clip(t - e, 0.0, 1.0)
+    # np.minimum/np.maximum: np.clip's own overhead (~10 us a call) adds up over the pairs
+    e = np.minimum(np.maximum(np.floor(t), 0), np.maximum(n_el[c] - 1, 0)).astype(np.int64)
+    theta = np.minimum(np.maximum(t - e, 0.0), 1.0)
     single = n_el[c] == 0
     nodes[:, 0] = first[c] + np.where(single, 0, e)
     weights[:, 0] = 1.0
@@ -532,9 +533,10 @@ class GridLocator:
         self.element = _basix_element("quadrilateral", degree)
 
     def _index(self, p):
-        i = np.clip(np.searchsorted(self.xl, p[:, 0], side="right") - 1, 0, len(self.xl) - 2)
-        j = np.clip(np.searchsorted(self.yl, p[:, 1], side="right") - 1, 0, len(self.yl) - 2)
-        return i, j
+        i = np.searchsorted(self.xl, p[:, 0], side="right") - 1
+        j = np.searchsorted(self.yl, p[:, 1], side="right") - 1
+        i, j = np.maximum(i, 0), np.maximum(j, 0)  # np.clip: ~10 us of overhead a call
+        return np.minimum(i, len(self.xl) - 2), np.minimum(j, len(self.yl) - 2)
 
     def cell_label(self, points, max_distance):
         """An integer per point that changes wherever its cell does: its grid cell's index (a
