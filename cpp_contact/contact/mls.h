@@ -62,7 +62,9 @@ struct MLSResult {
 ///
 /// The k-d tree (nanoflann) over the sources is built once in the constructor; the sources
 /// are copied. project() is const and keeps its scratch buffers local: it may be called
-/// concurrently.
+/// concurrently. Consecutive targets within h of a run's first (at most 64: the Gauss points
+/// of a cell) share one radius search; project() splits these runs among its threads, and the
+/// runs depend on the targets alone, so the results do not depend on the thread count.
 class MLSProjector {
 public:
   /// @brief Index the source points.
