@@ -188,6 +188,29 @@ def test_rejected_step_is_invisible():
     assert r["obstacles"] == r_ref["obstacles"]
 
 
+def test_each_step_frees_the_problem_it_replaces(monkeypatch):
+    """petsc4py frees no PETSc object when garbage-collected (each step would keep its
+    matrices and factorisation): a step destroys the problem it replaces, a failed step the
+    problem it made, and the current problem stays whole."""
+    from dolfinx_forms.solvers.problem import ContactProblem
+
+    sim = disc_sim(steps=3)
+    sim.step()
+    old = sim.problem
+    handles = [old.K, old.J, old.R, old.f, getattr(old.linear, "F", None) or old.linear.ksp]
+    assert all(h.handle != 0 for h in handles)
+    sim.step()
+    assert sim.problem is not old and all(h.handle == 0 for h in handles)
+    cur = sim.problem
+    destroyed, destroy = [], ContactProblem.destroy
+    monkeypatch.setattr(ContactProblem, "destroy", lambda p: (destroyed.append(p), destroy(p)))
+    sim.problem_kw["newton"] = NewtonOptions(max_iterations=1, max_cutbacks=0)
+    with pytest.raises(ContactSolverError):
+        sim.step()
+    assert len(destroyed) == 1 and destroyed[0] is not cur and destroyed[0].K is None
+    assert sim.problem is cur and cur.K.handle != 0 and cur.J.handle != 0
+
+
 def test_obstacle_motion_and_pose():
     """The pose maps the frame shape; a step's displacement is a rigid motion about the
     current centre; advance() moves the pose by it."""
