@@ -20,6 +20,24 @@ using contact::python::input;
 using contact::python::to_numpy;
 
 namespace {
+/// Both locators' locate(points, max_distance) as a dict of numpy arrays.
+template <class Locator>
+py::dict locate(const Locator& loc, const py::object& points, double max_distance,
+                const char* name) {
+  const auto pts = input<double>(Arg{name, "points"}, points, {any, 2});
+  const auto x = flat(pts);
+  LocatedPoints r;
+  {
+    py::gil_scoped_release release;
+    r = loc.locate(x, max_distance);
+  }
+  const auto n = py::ssize_t(r.cells.size());
+  py::dict d;
+  d["cells"] = to_numpy(std::move(r.cells), {n});
+  d["X"] = to_numpy(std::move(r.X), {n, 2});
+  d["outside"] = to_numpy(std::move(r.outside), {n});
+  return d;
+}
 CellLocator make_locator(const py::object& x_in, const py::object& cells_in,
                          const py::object& subset_in) {
   const char* f = "CellLocator";
@@ -70,21 +88,8 @@ void bind_location(py::module_& m) {
       .def_property_readonly("num_cells", &GridCellLocator::num_cells)
       .def(
           "locate",
-          [](const GridCellLocator& loc, const py::object& points, double max_distance) {
-            const auto pts =
-                input<double>(Arg{"GridCellLocator.locate", "points"}, points, {any, 2});
-            const auto x = flat(pts);
-            LocatedPoints r;
-            {
-              py::gil_scoped_release release;
-              r = loc.locate(x, max_distance);
-            }
-            const auto n = py::ssize_t(r.cells.size());
-            py::dict d;
-            d["cells"] = to_numpy(std::move(r.cells), {n});
-            d["X"] = to_numpy(std::move(r.X), {n, 2});
-            d["outside"] = to_numpy(std::move(r.outside), {n});
-            return d;
+          [](const GridCellLocator& l, const py::object& p, double d) {
+            return locate(l, p, d, "GridCellLocator.locate");
           },
           py::arg("points"), py::arg("max_distance") = 0.0,
           "Locate (n, 2) points: a dict of cells (int32, -1 if no cell of the 3 x 3 "
@@ -136,20 +141,8 @@ void bind_location(py::module_& m) {
       .def_property_readonly("bin_size", &CellLocator::bin_size, "Bin size along x and y")
       .def(
           "locate",
-          [](const CellLocator& loc, const py::object& points, double max_distance) {
-            const auto pts = input<double>(Arg{"CellLocator.locate", "points"}, points, {any, 2});
-            const auto x = flat(pts);
-            LocatedPoints r;
-            {
-              py::gil_scoped_release release;
-              r = loc.locate(x, max_distance);
-            }
-            const auto n = py::ssize_t(r.cells.size());
-            py::dict d;
-            d["cells"] = to_numpy(std::move(r.cells), {n});
-            d["X"] = to_numpy(std::move(r.X), {n, 2});
-            d["outside"] = to_numpy(std::move(r.outside), {n});
-            return d;
+          [](const CellLocator& l, const py::object& p, double d) {
+            return locate(l, p, d, "CellLocator.locate");
           },
           py::arg("points"), py::arg("max_distance") = 0.0,
           "Locate (n, 2) points. Returns a dict: cells (int32, -1 if further than max_distance "
