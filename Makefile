@@ -12,8 +12,9 @@ APT_PACKAGES := cmake make gcc g++ python3-sympy python3-dolfinx libdolfinx-dev 
 	libeigen3-dev python3-mpi4py python3-meshio pybind11-dev python3-pytest \
 	python3-scipy python3-matplotlib libgtest-dev libbenchmark-dev python3-setuptools \
 	python3-venv openmpi-bin libnanoflann-dev libopenblas0-pthread python3-h5py
-# only `make bench` installs these: benchmarks/work_precision.py compares with GetFEM's nodal P1
-BENCH_PACKAGES := python3-getfem
+# only `make bench` installs these: benchmarks/work_precision.py compares with GetFEM's nodal P1,
+# benchmarks/dem_peer.py runs LAMMPS's GRANULAR package (lmp) on demos/granular_column.py's test
+BENCH_PACKAGES := python3-getfem lammps
 # only `make test` installs these: tests/io/test_paraview.py opens the outputs in ParaView 5.11
 # (pvpython and paraview.simple; python3-paraview pulls in paraview) offscreen under xvfb-run
 # (Debian's ParaView renders through GLX only; xauth, which xvfb-run needs, is a Recommends)

@@ -39,13 +39,24 @@ def grain_assembly(comm, n=15, radius=5.0, h=0.5, aspect=1.25, overlap=None, mar
     hi = np.array([(centres[:, 0] + a).max() - overlap, (centres[:, 1] + b).max() - overlap])
     c = 0.5 * (lo + hi)
     centres, lo, hi = centres - c, lo - c, hi - c
+    plates = box_plates(lo, hi)
+    margin = 4 * h + 0.1 * radius if margin is None else margin
+    ax = [uniform_lines(lo[d] - margin, hi[d] + margin, h) for d in range(2)]
+    bodies = [(f"grain{k}", k + 1, df.Ellipse(tuple(x), a, b, 0.0)) for k, x in enumerate(centres)]
+    build = grid_scene(comm, ax[0], ax[1], [(q[0], q[1]) for q in bodies], contact_box=False)
+    return (ax[0], ax[1]), bodies, plates, build, np.array([lo, hi]), centres
+
+
+def box_plates(lo, hi):
+    """{plate_left, plate_right, plate_bottom, plate_top}: four rigid half-plane plates whose
+    inner faces bound the box [lo, hi] (each turns about its face's lower or left end)."""
     ext = 100 * (hi - lo).max()
     far = 2 * (hi - lo).max()
 
     def plate(name, point, normal, box, center):
         return RigidObstacle(name, half_plane(point, normal, ext), bbox=box, center=center)
 
-    plates = {
+    return {
         "plate_left": plate(
             "plate_left", (lo[0], 0), (1, 0), [[lo[0] - far, -far], [lo[0], far]], (lo[0], lo[1])
         ),
@@ -59,16 +70,14 @@ def grain_assembly(comm, n=15, radius=5.0, h=0.5, aspect=1.25, overlap=None, mar
             "plate_top", (0, hi[1]), (0, -1), [[-far, hi[1]], [far, hi[1] + far]], (0, hi[1])
         ),
     }
-    margin = 4 * h + 0.1 * radius if margin is None else margin
-    ax = [uniform_lines(lo[d] - margin, hi[d] + margin, h) for d in range(2)]
-    bodies = [(f"grain{k}", k + 1, df.Ellipse(tuple(x), a, b, 0.0)) for k, x in enumerate(centres)]
-    build = grid_scene(comm, ax[0], ax[1], [(q[0], q[1]) for q in bodies], contact_box=False)
-    return (ax[0], ax[1]), bodies, plates, build, np.array([lo, hi]), centres
 
 
-#: the plates of grain_assembly and their inward normals before any rotation
+#: the plates of box_plates and their inward normals before any rotation
 INWARD = {
-    "plate_left": (1, 0), "plate_right": (-1, 0), "plate_bottom": (0, 1), "plate_top": (0, -1)
+    "plate_left": (1, 0),
+    "plate_right": (-1, 0),
+    "plate_bottom": (0, 1),
+    "plate_top": (0, -1),
 }
 
 
@@ -83,3 +92,86 @@ def plate_frame_forces(record, plates):
         out[f"{name}_normal"] = float(-f @ m)
         out[f"{name}_tangential"] = float(f @ np.array([-m[1], m[0]]))
     return out
+
+
+def column_scene(comm, sample, h, widening=1.0):
+    """The material-point scene of a `meshes.column.Sample`: grid lines covering the walls' box
+    widened about its centre by `widening` (the shear's largest exp(gamma / 2)) plus 4 h,
+    the grains [(grain<i>, i + 1, exact shape)], the four plates on the box (box_plates) and
+    build_scene (body pairs from the simulation's broad phase)."""
+    from .column import shape
+
+    lo, hi = sample.box
+    c, half = 0.5 * (lo + hi), 0.5 * (hi - lo) * np.array([widening, 1.0])
+    ax = [uniform_lines(c[d] - half[d] - 4 * h, c[d] + half[d] + 4 * h, h) for d in range(2)]
+    bodies = [(f"grain{i}", i + 1, shape(sample, i)) for i in range(len(sample.radius))]
+    build = grid_scene(comm, ax[0], ax[1], [(q[0], q[1]) for q in bodies], contact_box=False)
+    return (ax[0], ax[1]), bodies, box_plates(lo, hi), build
+
+
+def bodies_top(sim):
+    """The highest point of the bodies' zero contours in an ImplicitMPM: per grid column of each
+    body's level-set window, the top node inside and the crossing above it, interpolated."""
+    top = -np.inf
+    for b in sim.bodies:
+        i0, i1, j0, j1 = sim.windows[b.tag]
+        v = sim.levelsets[b.tag].values  # (j1 - j0 + 1, i1 - i0 + 1)
+        rows = np.flatnonzero((v <= 0).any(axis=1))
+        if not len(rows):
+            continue
+        j = rows[-1]
+        if j + 1 >= v.shape[0]:
+            return float(sim.ylines[j0 + j])  # the window ends inside: cannot happen (margin)
+        a, b_ = v[j], v[j + 1]
+        inside = a <= 0
+        t = a[inside] / (a[inside] - b_[inside])  # the crossing between rows j and j + 1
+        top = max(top, float(sim.ylines[j0 + j] + sim.h * t.max()))
+    return top
+
+
+class ColumnWalls:
+    """The four plates of column_scene moved as a `meshes.column.Protocol` says: `prepare(t,
+    dt)` gives each plate its translation over [t, t + dt] (PointNewmark.advance's prepare);
+    `settle(sim)` measures the settled height at the end of deposition and puts the top plate
+    on the sample; `positions`, `forces(record)` (normal, compression positive) and
+    `vertical(record)` (the plates' total upward force on the grains) in meshes.column's
+    terms."""
+
+    NAMES = {"left": "plate_left", "right": "plate_right", "bottom": "plate_bottom",
+             "top": "plate_top"}  # fmt: skip
+
+    def __init__(self, plates, protocol):
+        self.plates, self.protocol, self.settled = plates, protocol, None
+
+    def positions(self):
+        return {k: float(self.plates[p].current_center[0 if k in ("left", "right") else 1])
+                for k, p in self.NAMES.items()}  # fmt: skip
+
+    def prepare(self, t, dt):
+        now, then = self.positions(), self.protocol.walls(t + dt, self.settled)
+        for k, p in self.NAMES.items():
+            d = then[k] - now[k]
+            self.plates[p].translation = np.array([d, 0.0] if k in ("left", "right") else [0, d])
+
+    def settle(self, sim):
+        bottom = self.protocol.box[0, 1]
+        self.settled = bodies_top(sim) - bottom
+        top = self.plates["plate_top"]
+        top.offset = top.offset + [0.0, bottom + self.settled - top.current_center[1]]
+        return self.settled
+
+    def forces(self, record):
+        f = plate_frame_forces(record, self.plates)
+        return {k: f[f"{p}_normal"] for k, p in self.NAMES.items()}
+
+    def vertical(self, record):
+        return -sum(record["obstacles"][p]["fy"] for p in self.NAMES.values())
+
+    def row(self, record, n_grains):
+        """The meshes.column.row of an ImplicitMPM step record (grain pairs: not a plate's)."""
+        from .column import row
+
+        normal = [q["normal_force"] for q in record["pairs"] if q["body_j"] not in self.plates]
+        energy = sum(record["kinetic_energy"].values())
+        return row(self.protocol, record["time"], self.positions(), self.forces(record), normal,
+                   n_grains, energy)  # fmt: skip

@@ -357,7 +357,7 @@ class ImplicitMPM:
         cut to `margin` cells around its nodes inside. Any window gives the same answers (the
         level set's values outside it are the shape's own, `_grow`): this one is small."""
         nx, ny = len(self.xlines), len(self.ylines)
-        ci, cj = np.r_[0 : nx : coarse, nx - 1], np.r_[0 : ny : coarse, ny - 1]
+        ci, cj = np.r_[0:nx:coarse, nx - 1], np.r_[0:ny:coarse, ny - 1]
         X, Y = np.meshgrid(self.xlines[ci], self.ylines[cj])
         P = np.ascontiguousarray(np.stack([X.ravel(), Y.ravel()], axis=1))
         phi = (shape.evaluate(P)[0] if isinstance(shape, _cpp.LevelSet) else shape(P)).reshape(
@@ -571,6 +571,13 @@ class ImplicitMPM:
             values = lambda t, pts: dyn.point_values(pts, dyn.rho[t])  # noqa: E731
             self._project(scene, values, [b.tag for b in self.bodies], 2 * d + 1, info, (q, qd),
                           True)  # fmt: skip
+            # the mass is the points' (constant); the level set's area drifts with advection
+            # (a percent over a deposit's hundreds of steps), so each body's density is scaled
+            # by points' volume / level-set area: its weight and inertia stay the points'
+            for b in self.bodies:
+                cells = scene.cell_tags.indices[scene.cell_tags.values == b.tag]
+                area = _cpp.levelset_area(self.levelsets[b.tag])
+                arr[qd[cells].ravel(), 2 * d] *= self.points[b.tag].vol.sum() / area
         laws.update(dyn.laws(laws, q, mp.DEGREE))
         return [dyn.load(q, mp.DEGREE)]
 

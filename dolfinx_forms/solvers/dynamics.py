@@ -43,6 +43,10 @@ def kinematics(du, v, a, dt, beta, gamma):
     return v + dt * ((1.0 - gamma) * a + gamma * a_new), a_new
 
 
+def _scalar(x):
+    return x if isinstance(x, ufl.core.expr.Expr) else float(x)
+
+
 class Inertia(Law):
     """A body's law plus the Newmark mass term c0 rho int u . w (module docstring) and, with
     viscous > 0, the damping term viscous int 2 sym grad u : grad w (the material point path's
@@ -50,14 +54,16 @@ class Inertia(Law):
     translation, second order in a rigid rotation's angle)."""
 
     def __init__(self, law, rho, c0, degree=None, viscous=0.0):
-        self.law, self.rho, self.c0 = law, rho, float(c0)  # rho: a number or a UFL coefficient
-        self.viscous = float(viscous)
+        # rho, c0, viscous: numbers or UFL expressions (a fem.Constant keeps the compiled form
+        # when the time step changes)
+        self.law, self.rho, self.c0 = law, rho, _scalar(c0)
+        self.viscous = _scalar(viscous)
         self.linear, self.modulus, self.p_modulus = law.linear, law.modulus, law.p_modulus
         self.quadrature_degree = degree or getattr(law, "quadrature_degree", None)
 
     def residual(self, u, v, dx):
         r = self.law.residual(u, v, dx) + self.c0 * self.rho * ufl.inner(u, v) * dx
-        if self.viscous > 0:
+        if not (isinstance(self.viscous, float) and self.viscous == 0):
             r += self.viscous * 2 * ufl.inner(ufl.sym(ufl.grad(u)), ufl.grad(v)) * dx
         return r
 

@@ -42,3 +42,31 @@ def test_a_failed_step_is_undone_and_done_again_at_half_the_step():
         assert same(getattr(ref.points[1], name), getattr(again.points[1], name)), name
     assert same(ref.levelsets[1].values, again.levelsets[1].values)
     assert same(first["obstacles"]["floor"]["fy"], step["obstacles"]["floor"]["fy"])
+
+
+def test_drag_follows_the_newmark_recursion_of_a_falling_body():
+    """Rayleigh's mass damping alpha (PointNewmark(mass_damping=...)) on a disc in free fall:
+    its points move rigidly with v' = -g - alpha v, whose trapezoidal rule is the recursion
+    v_{n+1} (1 + alpha dt / 2) = v_n (1 - alpha dt / 2) - g dt (a_0 = -g); the points' v equal
+    it to round-off (1e-9), the dissipative rule (gamma 0.6) too with its own recursion, and the
+    terminal velocity g / alpha is approached."""
+    import dolfinx_forms as df
+    from meshes.mpm import grid_scene, uniform_lines
+
+    xl, yl = uniform_lines(-1.5, 1.5, 0.1), uniform_lines(-4.5, 1.5, 0.1)
+    g, alpha, dt = 1.0, 2.0, 0.1
+    for integrator in ("trapezoidal", "dissipative"):
+        dyn = PointNewmark({1: 1.0}, dt, integrator, gravity=(0.0, -g), mass_damping=alpha)
+        body = MPMBody("d", 1, NeoHookean(1e3, 0.3), df.Circle((0.0, 0.0), 1.0))
+        sim = ImplicitMPM(MPI.COMM_SELF, (xl, yl), [body],
+                          grid_scene(MPI.COMM_SELF, xl, yl, [("d", 1)]), dynamics=dyn,
+                          log=lambda *a, **k: None)  # fmt: skip
+        v, a, gm = 0.0, -g, dyn.gamma
+        for _ in range(20):
+            sim.step()
+            # v_{n+1} = v + dt ((1 - gm) a + gm a1), a1 = -g - alpha v_{n+1}
+            v_new = (v + dt * (1 - gm) * a - gm * dt * g) / (1 + gm * dt * alpha)
+            v, a = v_new, -g - alpha * v_new
+            assert np.allclose(sim.points[1].v[:, 1], v, rtol=1e-9, atol=1e-12)
+            assert np.allclose(sim.points[1].v[:, 0], 0.0, atol=1e-12)
+        assert abs(v + g / alpha) < 0.03 * g / alpha  # t = 2: 1 - exp(-4) of the terminal
