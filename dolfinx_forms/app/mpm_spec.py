@@ -14,7 +14,12 @@ in brackets; lengths and forces in the scene's units, angles in degrees):
       [2 h; doubled while active points reach its edge], ghost_penalty [0.01], grid_refine
       [4], num_gauss [2], linear_solver ["auto"], petsc {KEY = VALUE}, newton {rtol, ftol,
       atol, stol, max_iterations, max_cutbacks}, predictor_gap [0], reinit_drift [0.2]
-  [[bodies]]  name, shape (circle, ellipse, box, polygon: as scene_spec), law = {type =
+  [dynamics]  (optional: inertia, each stage step a time step; mpm/dynamics.py PointNewmark)
+      dt, integrator ["dissipative"] or "trapezoidal", gravity [[0, 0]] (per unit mass),
+      viscosity [0] (Kelvin-Voigt eta: spares rigid motions), mass_damping [0] (Rayleigh's
+      alpha: a drag alpha rho v)
+  [[bodies]]  name, rho [1] (the density, with [dynamics]), shape (circle, ellipse, box,
+      polygon: as scene_spec), law = {type =
       "linear", E, nu} | {type = "orthotropic", ...} (small strain per step) | {type =
       "neo-hookean", E, nu} | {type = "j2", E, nu, yield_stress, hardening [0]} (finite
       strain: F and the history at the points, mpm/finite_strain.py)
@@ -160,7 +165,8 @@ def _bodies(top, base_dir):
                 b.path("law.type"),
                 f"the multi-step path takes the laws {', '.join(MPM_LAWS)}, got {law['type']!r}",
             )
-        bodies[name] = {"name": name, "shape": shape, "law": law}
+        rho = b.number("rho", 1.0, lo=0, lo_open=True)
+        bodies[name] = {"name": name, "shape": shape, "law": law, "rho": rho}
         b.done()
     if not bodies:
         raise SpecError("bodies", "missing (at least one [[bodies]] table)")
@@ -282,6 +288,19 @@ def _stage(t, i, obstacles, dirichlet, h):
     return st
 
 
+def _dynamics(t):
+    from dolfinx_forms.solvers.dynamics import INTEGRATORS
+
+    d = dict(dt=t.number("dt", lo=0, lo_open=True),
+             integrator=t.string("integrator", "dissipative", choices=tuple(INTEGRATORS)),
+             gravity=t.point("gravity", [0.0, 0.0]), viscosity=t.number("viscosity", 0.0, lo=0),
+             mass_damping=t.number("mass_damping", 0.0, lo=0))  # fmt: skip
+    if len(d["gravity"]) != 2:
+        raise SpecError(t.path("gravity"), f"must be [gx, gy], got {d['gravity']}")
+    t.done()
+    return d
+
+
 def _analytic(t, bodies, obstacles):
     kind = t.string("type", choices=("hertz",))
     body = name_ref(t, "body", [b["name"] for b in bodies], "body")
@@ -296,7 +315,8 @@ def _analytic(t, bodies, obstacles):
 
 
 RESULTS = ("steps", "equilibrium_rel_max", "area_vs_points_rel_max", "mass_rel_change_max",
-           "newton_iterations_mean", "contacts_final", "obstacle_forces", "band_final")  # fmt: skip
+           "newton_iterations_mean", "contacts_final", "obstacle_forces", "band_final",
+           "time_final", "kinetic_energy_final")  # fmt: skip
 HERTZ_RESULTS = ("half_width", "steps_judged", "half_width_rel_error_max")
 
 
@@ -331,6 +351,8 @@ def validate(data, base_dir=None, default_name="scene"):
     units.done()
     spec["grid"] = grid = _grid(top.table("grid"))
     spec["solver"] = _solver(top.table("solver", {}))
+    dyn = top.table("dynamics", None)
+    spec["dynamics"] = None if dyn is None else _dynamics(dyn)
     spec["bodies"] = _bodies(top, base_dir)
     names = [b["name"] for b in spec["bodies"]]
     spec["obstacles"] = _obstacles(top, base_dir, names)
