@@ -12,9 +12,9 @@ failed step done again at half the step. MELODY's protocol (meshes/column.py): d
 height over --t-compress; biaxial shear at constant area to --shear-strain (eps_yy - eps_xx)
 over --t-shear, the lateral walls moving apart and the top wall down.
 
-The check. At the end of deposition the walls carry the grains' weight (2 %). steps.csv: the
-columns of meshes/column.py (wall forces, stress ratio, coordination number, the contact
-forces' mean and spread), Newton iterations, retried steps; contacts.csv: the force chains.
+The check. At the end of deposition the walls carry the grains' weight (2 %). steps.csv:
+meshes/column.py's columns (wall forces, stress ratio, coordination, the contact forces' mean
+and spread), Newton iterations, retries; contacts.csv, force_chains.png, column.png.
 benchmarks/dem_peer.py runs the same sample and protocol with LAMMPS (rigid discs).
 
 Run: /usr/bin/python3 demos/granular_column.py [--grains 100] [--E 1e4]
@@ -37,6 +37,7 @@ from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
 from dolfinx_forms.solvers.newton import NewtonOptions
 from meshes import column
 from meshes.assembly import ColumnWalls, column_scene
+from meshes.plots import granular_column_plots
 
 # fmt: off
 OPTIONS = [  # option, kind, default[, help]
@@ -88,8 +89,8 @@ def evaluate(run, weight, deposited):
              kinetic_energy_deposited=deposited["kinetic_energy"],
              settled_height=run.data.get("settled"))  # fmt: skip
     r.update({f"end_of_{q['phase']}": {k: q[k] for k in column.COLUMNS[1:]} for q in run.rows})
-    r["newton_per_step"] = float(np.mean([q["newton_iterations"] for q in run.rows]))
-    r["retried_steps"] = int(sum(q["retries"] for q in run.rows))
+    r.update(newton_per_step=float(np.mean([q["newton_iterations"] for q in run.rows])),
+             retried_steps=int(sum(q["retries"] for q in run.rows)))  # fmt: skip
     if abs(r["walls_over_weight_deposited"] - 1) > 0.02:
         warn.append(f"after deposition the walls carry {r['walls_over_weight_deposited']:.4f} "
                     "of the weight (> 2 % off): not at rest; raise --t-deposit")  # fmt: skip
@@ -103,8 +104,7 @@ def main(argv=None):
                                       args.elongation, args.roughness, seed=args.seed)  # fmt: skip
         protocol = column.Protocol(sample.box, args.t_deposit, args.t_compress, args.t_shear,
                                    args.compression, args.shear_strain)  # fmt: skip
-        grid, grains, plates, scene = column_scene(run.comm, sample, args.h,
-                                                   np.exp(args.shear_strain / 2))  # fmt: skip
+        grid, grains, plates, scene = column_scene(run.comm, sample, args.h, args.shear_strain)
         # the problem: each grain its law and mass, Coulomb friction everywhere, inertia
         law = NeoHookean(args.E, args.nu) if args.law == "neo-hookean" else (args.E, args.nu)
         bodies = [MPMBody(name, tag, law, s) for name, tag, s in grains]
@@ -142,7 +142,7 @@ def main(argv=None):
                    "carry {results[walls_over_weight_deposited]:.4f} of the weight; "
                    "Newton per step {results[newton_per_step]:.1f}, "
                    "{results[retried_steps]} retried steps")  # fmt: skip
-        run.finish(summary, **steps.outputs())
+        run.finish(summary, **steps.outputs(granular_column_plots))
     return run.status
 
 

@@ -94,15 +94,16 @@ def plate_frame_forces(record, plates):
     return out
 
 
-def column_scene(comm, sample, h, widening=1.0):
+def column_scene(comm, sample, h, shear_strain=0.0):
     """The material-point scene of a `meshes.column.Sample`: grid lines covering the walls' box
-    widened about its centre by `widening` (the shear's largest exp(gamma / 2)) plus 4 h,
+    widened about its centre by exp(shear_strain / 2) (the walls at the end of the shear of
+    meshes.column.Protocol) plus 4 h,
     the grains [(grain<i>, i + 1, exact shape)], the four plates on the box (box_plates) and
     build_scene (body pairs from the simulation's broad phase)."""
     from .column import shape
 
     lo, hi = sample.box
-    c, half = 0.5 * (lo + hi), 0.5 * (hi - lo) * np.array([widening, 1.0])
+    c, half = 0.5 * (lo + hi), 0.5 * (hi - lo) * np.array([np.exp(shear_strain / 2), 1.0])
     ax = [uniform_lines(c[d] - half[d] - 4 * h, c[d] + half[d] + 4 * h, h) for d in range(2)]
     bodies = [(f"grain{i}", i + 1, shape(sample, i)) for i in range(len(sample.radius))]
     build = grid_scene(comm, ax[0], ax[1], [(q[0], q[1]) for q in bodies], contact_box=False)

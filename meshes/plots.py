@@ -142,6 +142,30 @@ def grain_assembly_plots(run, folder):
     _save(plt, fig, folder / "plate_forces.png")
 
 
+def granular_column_plots(run, folder):
+    """demos/granular_column.py: force_chains.png (the last step) and column.png (the walls'
+    forces, the stress ratio and the coordination number against time; dotted: the ends of
+    deposition and compression)."""
+    plt = _pyplot()
+    plot_force_chains(run.sim, run.records[-1], folder / "force_chains.png", "granular column")
+    rows, p = run.rows, run.params
+    t = [r["t"] for r in rows]
+    fig, ax = plt.subplots(3, 1, figsize=(6, 8), sharex=True)
+    for k in ("left", "right", "bottom", "top"):
+        ax[0].plot(t, [r[f"force_{k}"] for r in rows], label=k)
+    ax[0].set(ylabel="wall force (normal)")
+    ax[0].legend(fontsize=8, ncol=4)
+    ax[1].plot(t, [np.nan if r["stress_ratio"] is None else r["stress_ratio"] for r in rows])
+    ax[1].set(ylabel="stress ratio $\\sigma_{yy} / \\sigma_{xx}$")
+    ax[2].plot(t, [r["coordination"] for r in rows])
+    ax[2].set(xlabel="time", ylabel="coordination number")
+    for a in ax:
+        for end in (p["t_deposit"], p["t_deposit"] + p["t_compress"]):
+            a.axvline(end, color="0.6", ls=":")
+    ax[0].set_title("granular column: deposition | compression | shear")
+    _save(plt, fig, folder / "column.png")
+
+
 def contact_geometry_plot(run, path):
     """demos/contact_geometry.py: the bodies' zero contours and Gamma_c's segments (left), the
     computed initial gaps g_n0 against the exact ones (right)."""
