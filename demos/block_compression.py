@@ -3,14 +3,13 @@
 
 Physics. A width x height block (plane strain) between frictionless rigid platens wider than
 it; the upper moves down in --steps equal steps to --compression of the height. --law linear
-(small strain), neo-hookean or j2 (finite strain: F and the law's history at the points,
-mpm/finite_strain.py; fem/plasticity.py). u_x = 0 on x = 0 holds the only free rigid motion.
+(small strain), neo-hookean, j2 or drucker-prager (finite strain: F and the law's history at
+the points, mpm/finite_strain.py; fem/plasticity.py). u_x = 0 on x = 0 holds the free motion.
 
 The check. F = diag(l_x, l_y), l_y = 1 - compression, l_x from sigma_xx = 0: the force per unit
-thickness against |P_yy| times the initial width (neo-Hookean closed form; j2 and linear
-integrated along the steps, analytic.block_*), the width at mid-height against l_x times the
-width, the level-set area against the points' volume, the mass.
-
+thickness against |P_yy| times the initial width (neo-Hookean closed form; plastic and linear
+integrated along the steps, analytic.block_*), the width at mid-height against l_x W, the
+level-set area against the points' volume, the mass.
 Run: /usr/bin/python3 demos/block_compression.py [--law j2]  (docs/demos/block_compression.md)
 """
 
@@ -24,12 +23,10 @@ if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNot
     sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
              "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
 from dolfinx_forms.analysis import analytic
-from dolfinx_forms.app import cli
+from dolfinx_forms.app import cli, spec_values
 from dolfinx_forms.app.demo import Run
 from dolfinx_forms.app.mpm_run import Steps
 from dolfinx_forms.fem.boundary import Dirichlet
-from dolfinx_forms.fem.laws import LinearElastic, NeoHookean
-from dolfinx_forms.fem.plasticity import J2Plasticity
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
 from meshes.mpm import block_between_platens, check_block, width_at
 from meshes.plots import block_plots
@@ -39,11 +36,14 @@ OPTIONS = [  # option, kind, default[, help]
     ("--width", "(0, 1e6]", 2.0, "block width (mm)"),
     ("--height", "(0, 1e6]", 2.0, "block height (mm)"),
     ("--compression", "(0, 0.5]", 0.3, "platen travel as a fraction of the height"),
-    ("--law", ["neo-hookean", "linear", "j2"], "neo-hookean", "bulk law"),
+    ("--law", ["neo-hookean", "linear", "j2", "drucker-prager"], "neo-hookean", "bulk law"),
     ("--E", "[1e-3, 1e7]", 1000.0, "Young's modulus (N/mm^2)"),
     ("--nu", "(-1, 0.5)", 0.3),
     ("--yield-stress", "(0, inf)", 50.0, "j2: initial yield stress (N/mm^2)"),
-    ("--hardening", "[0, inf)", 100.0, "j2: linear isotropic hardening modulus (N/mm^2)"),
+    ("--hardening", "[0, inf)", 100.0, "j2, drucker-prager: linear hardening (N/mm^2)"),
+    ("--cohesion", "(0, inf)", 5.0, "drucker-prager: cohesion (N/mm^2)"),
+    ("--friction-angle", "(0, 90)", 30.0, "drucker-prager: friction angle (degrees)"),
+    ("--dilatancy-angle", "(0, 90)", 10.0, "drucker-prager: dilatancy angle (degrees)"),
     ("--steps", range(1, 10001), 20),
     ("--h", "(0, inf)", 0.05, "grid spacing (mm)"),
     ("--eps0", cli.MPM_EPS0_INTERVAL, 0.1, "penalty factor (eq 51; 0.1: no checkerboard)"),
@@ -51,6 +51,8 @@ OPTIONS = [  # option, kind, default[, help]
 ]
 COLUMNS = ["step", "compression", "force", "width", "area_levelset", "volume_points"]
 TOLERANCE = 0.02  # force and width against the homogeneous solution (docs/demos)
+PLASTIC = {"linear": (), "neo-hookean": (), "j2": ("yield_stress", "hardening"),
+           "drucker-prager": ("cohesion", "friction_angle", "dilatancy_angle", "hardening")}
 # fmt: on
 
 
@@ -62,22 +64,23 @@ def parse(argv):
         check_block(a.width, a.height, a.h, a.compression, a.steps)
     except ValueError as e:
         p.error(str(e))
+    if a.law == "drucker-prager" and a.dilatancy_angle > a.friction_angle:
+        p.error(f"--dilatancy-angle: must be <= --friction-angle, got {a.dilatancy_angle}")
     return a
 
 
-def make_law(p):
-    j2 = (p["E"], p["nu"], p["yield_stress"], p["hardening"])
-    return {"linear": LinearElastic, "neo-hookean": NeoHookean}.get(p["law"], J2Plasticity)(
-        *(j2 if p["law"] == "j2" else j2[:2]))  # fmt: skip
+def make_law(p):  # the one place a law's parameters become a Law: spec_values.make_law
+    return spec_values.make_law(dict(type=p["law"], E=p["E"], nu=p["nu"],
+                                     **{k: p[k] for k in PLASTIC[p["law"]]}))  # fmt: skip
 
 
 def reference(p, ly):
     """(force, l_x) of the homogeneous block at the stretches ly (module docstring)."""
-    W, law, E, nu = p["width"], make_law(p), p["E"], p["nu"]
+    W, law, E, nu, extra = p["width"], make_law(p), p["E"], p["nu"], PLASTIC[p["law"]]
+    plastic = {"j2": analytic.block_j2, "drucker-prager": analytic.block_drucker_prager}
     return {"neo-hookean": lambda: analytic.block_neo_hookean(ly, W, law.mu, law.lmbda),
-            "linear": lambda: analytic.block_hypoelastic(ly, W, E, nu),
-            "j2": lambda: analytic.block_j2(ly, W, E, nu, p["yield_stress"], p["hardening"])[:2],
-            }[p["law"]]()  # fmt: skip
+            "linear": lambda: analytic.block_hypoelastic(ly, W, E, nu)}.get(
+        p["law"], lambda: plastic[p["law"]](ly, W, E, nu, *map(p.get, extra))[:2])()  # fmt: skip
 
 
 def evaluate(run):
@@ -133,14 +136,11 @@ def main(argv=None):
         for _ in range(args.steps):
             rec, k = steps.step(), len(steps.rows) + 1
             steps.rows.append(dict(step=k, compression=k * args.compression / args.steps,
-                force=rec["obstacles"]["platen_top"]["fy"],
-                width=width_at(sim.levelsets[tag], 0.0),
+                force=rec["obstacles"]["platen_top"]["fy"], width=width_at(sim.levelsets[tag], 0),
                 area_levelset=rec["area_levelset"]["block"],
-                volume_points=rec["volume_points"]["block"],
-            ))  # fmt: skip
+                volume_points=rec["volume_points"]["block"]))  # fmt: skip
         steps.measure()
-        # the check (rank 0): force and width against the homogeneous solution
-        if run.rank0:
+        if run.rank0:  # the check: force and width against the homogeneous solution
             evaluate(run)
         run.finish(summary, **steps.outputs(partial(block_plots, reference=reference)))
     return run.status

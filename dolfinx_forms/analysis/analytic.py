@@ -142,30 +142,73 @@ def block_hypoelastic(ly, width, E, nu):
     return tuple(np.array(v) for v in zip(*out))
 
 
-def block_j2(ly, width, E, nu, yield_stress, hardening):
-    """Finite-strain J2 (plasticity.J2Plasticity: logarithmic elastic strain, Kirchhoff
-    stress, radial return) integrated along the steps l_y[0], l_y[1], ... from the virgin
-    state, in principal axes x, y, z (the block's never rotate); each step's l_x from
-    tau_xx = 0. An independent principal-space implementation. Returns (force, l_x, alpha)."""
+def _block_path(ly, width, E, nu, ret):
+    """The homogeneous block of a log-strain plasticity law with the return mapping
+    ret(eps (3,), alpha) -> (elastic strain (3,), dalpha) in principal axes x, y, z (the
+    block's never rotate), integrated along the steps l_y[0], l_y[1], ... from the virgin
+    state; each step's l_x from tau_xx = 0. Returns (force, l_x, alpha)."""
     G, lmbda = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
     K = lmbda + 2 * G / 3
     be, alpha, lx0, y0, out = np.ones(3), 0.0, 1.0, 1.0, []
 
     def update(f):
-        eps = 0.5 * np.log(f**2 * be)
+        e, da = ret(0.5 * np.log(f**2 * be), alpha)
+        return K * e.sum() + 2 * G * (e - e.sum() / 3), e, da
+
+    for y in np.atleast_1d(ly):
+        lx = _free_stretch(lambda x: update(np.array([x / lx0, y / y0, 1.0]))[0][0], lx0)
+        tau, e, da = update(np.array([lx / lx0, y / y0, 1.0]))
+        be, alpha, lx0, y0 = np.exp(2 * e), alpha + da, lx, y
+        out.append((abs(tau[1]) / y * width, lx, alpha))
+    return tuple(np.array(v) for v in zip(*out))
+
+
+def block_j2(ly, width, E, nu, yield_stress, hardening):
+    """Finite-strain J2 (plasticity.J2Plasticity: logarithmic elastic strain, Kirchhoff
+    stress, radial return) along the block path (_block_path): an independent principal-space
+    implementation. Returns (force, l_x, alpha)."""
+    G = E / (2 * (1 + nu))
+
+    def ret(eps, alpha):
         dev = eps - eps.sum() / 3
         q = np.sqrt(1.5) * 2 * G * np.linalg.norm(dev)
         phi = q - (yield_stress + hardening * alpha)
         dg = max(phi, 0.0) / (3 * G + hardening)
-        e = eps.sum() / 3 + (1 - 3 * G * dg / q if phi > 0 else 1.0) * dev
-        return K * e.sum() + 2 * G * (e - e.sum() / 3), e, dg
+        return eps.sum() / 3 + (1 - 3 * G * dg / q if phi > 0 else 1.0) * dev, dg
 
-    for y in np.atleast_1d(ly):
-        lx = _free_stretch(lambda x: update(np.array([x / lx0, y / y0, 1.0]))[0][0], lx0)
-        tau, e, dg = update(np.array([lx / lx0, y / y0, 1.0]))
-        be, alpha, lx0, y0 = np.exp(2 * e), alpha + dg, lx, y
-        out.append((abs(tau[1]) / y * width, lx, alpha))
-    return tuple(np.array(v) for v in zip(*out))
+    return _block_path(ly, width, E, nu, ret)
+
+
+def drucker_prager_return(eps, alpha, E, nu, cohesion, friction_angle, dilatancy_angle,
+                          hardening):  # fmt: skip
+    """The Drucker-Prager return mapping (plasticity.DruckerPrager: the cone's smooth part,
+    else its apex) of principal trial logarithmic strains eps (3,) in numpy, an independent
+    implementation: (elastic strains (3,), dalpha)."""
+    from dolfinx_forms.fem.plasticity import drucker_prager_coefficients
+
+    G, lmbda = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
+    K, H = lmbda + 2 * G / 3, hardening
+    eta, xi, eb = drucker_prager_coefficients(friction_angle, dilatancy_angle)
+    p, s = K * eps.sum(), 2 * G * (eps - eps.sum() / 3)
+    sq, c = np.sqrt(0.5 * s @ s), cohesion + H * alpha
+    f = sq + eta * p - xi * c
+    if f <= 0:
+        return eps, 0.0
+    dg = f / (G + K * eta * eb + xi**2 * H)
+    if sq - G * dg >= 0:  # the cone's smooth part
+        s, p, da = (1 - G * dg / sq) * s, p - K * eb * dg, xi * dg
+    else:  # the apex
+        dv = (p - xi / eta * c) / (K + H * xi**2 / (eta * eb))
+        s, p, da = 0 * s, p - K * dv, xi / eb * dv
+    return s / (2 * G) + p / (3 * K), da
+
+
+def block_drucker_prager(ly, width, E, nu, cohesion, friction_angle, dilatancy_angle,
+                         hardening):  # fmt: skip
+    """Finite-strain Drucker-Prager along the block path (_block_path, drucker_prager_return).
+    Returns (force, l_x, alpha)."""
+    law = (E, nu, cohesion, friction_angle, dilatancy_angle, hardening)
+    return _block_path(ly, width, E, nu, lambda eps, a: drucker_prager_return(eps, a, *law))
 
 
 # ---------------------------------------------------------------- flat punch (Johnson 1985, 2.8)

@@ -21,8 +21,9 @@ in brackets; lengths and forces in the scene's units, angles in degrees):
   [[bodies]]  name, rho [1] (the density, with [dynamics]), shape (circle, ellipse, box,
       polygon: as scene_spec), law = {type =
       "linear", E, nu} | {type = "orthotropic", ...} (small strain per step) | {type =
-      "neo-hookean", E, nu} | {type = "j2", E, nu, yield_stress, hardening [0]} (finite
-      strain: F and the history at the points, mpm/finite_strain.py)
+      "neo-hookean", E, nu} | {type = "j2", E, nu, yield_stress, hardening [0]} | {type =
+      "drucker-prager", E, nu, cohesion, friction_angle, dilatancy_angle [friction_angle],
+      hardening [0]} (finite strain: F and the history at the points, mpm/finite_strain.py)
   [[obstacles]]  name, shape (any shape of scene_spec, half_plane included: normal outward
       from the obstacle), centre [the shape's centre; a half-plane's point; a polygon's
       vertex mean] (the point it turns about and its moment is taken about), bodies [every
@@ -66,7 +67,7 @@ from dolfinx_forms.app.spec_values import (
 )
 
 MAX_GRID_CELLS = 16_000_000  # 4000 x 4000
-MPM_LAWS = ("linear", "orthotropic", "neo-hookean", "j2")
+MPM_LAWS = ("linear", "orthotropic", "neo-hookean", "j2", "drucker-prager")
 MAX_STEPS = 100_000
 
 

@@ -261,11 +261,11 @@ def _bodies(top, base_dir):
             "law": parse_law(b.table("law")),
             "window": b.box("window", None),
         }
-        if bodies[name]["law"]["type"] == "j2":
+        if bodies[name]["law"]["type"] in ("j2", "drucker-prager"):
             raise SpecError(
                 b.path("law.type"),
-                "j2 carries a history the single-step runner does not commit between its load "
-                "steps: use it in a method = \"mpm\" description",
+                f"{bodies[name]['law']['type']} carries a history the single-step runner does "
+                "not commit between its load steps: use it in a method = \"mpm\" description",
             )
         if bodies[name]["shape"]["type"] == "half_plane" and bodies[name]["window"] is None:
             raise SpecError(b.path("window"), "a half_plane body needs a window")

@@ -25,9 +25,14 @@ LAW_PARAMETERS = {  # type -> (required, optional with defaults); laws.LAWS buil
     # finite-strain J2 (fem/plasticity.py): the multi-step path only (its history lives on
     # the material points; a single-step description refuses it, scene_spec)
     "j2": (("E", "nu", "yield_stress"), {"hardening": 0.0}),
+    # finite-strain Drucker-Prager, the same way; angles in degrees, dilatancy_angle None:
+    # associative (the friction angle)
+    "drucker-prager": (("E", "nu", "cohesion", "friction_angle"),
+                       {"dilatancy_angle": None, "hardening": 0.0}),  # fmt: skip
 }
 BOUNDS = {"nu": dict(lo=-1, hi=0.5, lo_open=True, hi_open=True)}  # others: moduli > 0
-BOUNDS.update({k: dict(lo=0, lo_open=True) for k in ("E", "E1", "E2", "E3", "G12", "yield_stress")})
+BOUNDS.update({k: dict(lo=0, lo_open=True) for k in ("E", "E1", "E2", "E3", "G12", "yield_stress",
+                                                      "cohesion")})  # fmt: skip
 SHAPES = {  # type -> (required, optional with defaults)
     "circle": (("centre", "radius"), {}),
     "ellipse": (("centre", "axes"), {"angle": 0.0}),
@@ -321,10 +326,10 @@ def make_law(law):
     """The solver material of a checked law description: the one place where a description
     becomes a `laws.Law` (angles in the description are in degrees)."""
     from dolfinx_forms.fem.laws import LAWS
-    from dolfinx_forms.fem.plasticity import J2Plasticity
+    from dolfinx_forms.fem.plasticity import DruckerPrager, J2Plasticity
 
     params = {k: v for k, v in law.items() if k != "type"}
-    return dict(LAWS, j2=J2Plasticity)[law["type"]](**params)
+    return dict(LAWS, j2=J2Plasticity, **{"drucker-prager": DruckerPrager})[law["type"]](**params)
 
 
 def parse_law(t):

@@ -201,6 +201,27 @@ def test_finite_strain_laws_and_the_augmented_lagrangian_from_a_file(tmp_path):
     assert e.value.key == "bodies[0].law.type" and "mpm" in str(e.value)
 
 
+def test_drucker_prager_from_a_description():
+    """A drucker-prager law in a multi-step description becomes fem.plasticity.DruckerPrager
+    (the dilatancy angle defaults to the friction angle: associative); a bad angle is refused
+    naming the law, and the single-step path refuses the law."""
+    from dolfinx_forms.app.spec_values import make_law
+    from dolfinx_forms.fem.plasticity import DruckerPrager
+
+    dp = "{type='drucker-prager', E=100.0, nu=0.3, cohesion=1.0, friction_angle=30.0"
+    law = make_law(load(BASE, [f"bodies[0].law={dp}}}"])["bodies"][0]["law"])
+    assert isinstance(law, DruckerPrager) and law.eta == law.eta_bar > 0
+    law = make_law(load(BASE, [f"bodies[0].law={dp}, dilatancy_angle=10.0}}"])["bodies"][0]["law"])
+    assert 0 < law.eta_bar < law.eta
+    for bad in (f"{dp}, dilatancy_angle=40.0}}", dp.replace("30.0", "0.0") + "}"):
+        with pytest.raises(SpecError) as e:
+            load(BASE, [f"bodies[0].law={bad}"])
+        assert e.value.key == "bodies[0].law" and "friction_angle" in str(e.value)
+    with pytest.raises(SpecError) as e:
+        load(SCENES / "hertz.toml", [f"bodies[0].law={dp}}}"])
+    assert e.value.key == "bodies[0].law.type" and "mpm" in str(e.value)
+
+
 def test_dynamics_from_a_file_gives_the_bouncing_disc(tmp_path):
     """demos/scenes/bouncing_disc.toml ([dynamics]: inertia, gravity, Kelvin-Voigt damping) is
     demos/bouncing_disc.py moved up by h / 2: over the first 0.6 s (the impact at 0.45 s) the

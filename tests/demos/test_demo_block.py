@@ -10,10 +10,11 @@ from demo_tests import assert_refused, load_demo
 demo = load_demo("block_compression")
 
 
-@pytest.mark.parametrize("law", ["neo-hookean", "j2", "linear"])
+@pytest.mark.parametrize("law", ["neo-hookean", "j2", "linear", "drucker-prager"])
 def test_coarse_run_against_the_homogeneous_solution(law, tmp_path):
     """h = height/40, 20 % compression in 8 steps. Measured force errors 0.56 % (neo-Hookean),
-    0.68 % (j2), 1.04 % (linear) here, from the level-set corners at the platens
+    0.68 % (j2), 1.04 % (linear), 1.91 % (drucker-prager) here, from the level-set corners at
+    the platens
     (docs/demos/block_compression.md): 2 % is the demo's own
     tolerance; the width at mid-height within 2 %; area and point volume within 1 %."""
     out = tmp_path / law
@@ -44,6 +45,9 @@ def test_coarse_run_against_the_homogeneous_solution(law, tmp_path):
         (["--yield-stress", "0"], "--yield-stress"),
         (["--hardening", "-1"], "--hardening"),
         (["--eps0", "10"], "--eps0"),
+        (["--friction-angle", "90"], "--friction-angle"),
+        (["--law", "drucker-prager", "--dilatancy-angle", "40"], "--dilatancy-angle"),
+        (["--cohesion", "0"], "--cohesion"),
     ],
 )
 def test_bad_input_exits_2_naming_the_parameter(args, word, tmp_path, capsys):

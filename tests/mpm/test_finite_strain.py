@@ -14,7 +14,7 @@ from mpi4py import MPI
 from dolfinx_forms.analysis import analytic
 from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.fem.laws import LinearElastic, NeoHookean
-from dolfinx_forms.fem.plasticity import J2Plasticity
+from dolfinx_forms.fem.plasticity import DruckerPrager, J2Plasticity
 from dolfinx_forms.mpm import material_points as mp
 from dolfinx_forms.mpm.finite_strain import PointLaw, UpdatedLaw
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
@@ -24,6 +24,7 @@ from meshes.mpm import grid_scene, uniform_lines
 
 E, NU = 1000.0, 0.3
 J2 = dict(yield_stress=50.0, hardening=100.0)
+DP = (5.0, 30.0, 10.0, 50.0)  # cohesion, friction and dilatancy angles (degrees), hardening
 
 
 def points(law, n=7):
@@ -90,12 +91,51 @@ def test_j2_return_mapping_equals_the_principal_space_reference():
     assert alpha[3] > 0 and alpha[0] == 0  # the path yields
 
 
-def test_j2_tangent_is_the_consistent_one():
+def test_drucker_prager_return_mapping_equals_the_principal_space_reference():
+    """DruckerPrager in UFL against analytic.drucker_prager_return (numpy, principal space):
+    along the homogeneous block path (analytic.block_drucker_prager: force, l_x, alpha to
+    1e-10, through yield and hardening), and in one step from the virgin state for F with
+    shear, compression and in-plane expansion (the smooth cone and the apex: Cauchy stress and
+    alpha to 1e-10)."""
+    ly = 1 - np.linspace(0.005, 0.2, 20)
+    force, lx, alpha = analytic.block_drucker_prager(ly, 2.0, E, NU, *DP)
+    law = DruckerPrager(E, NU, *DP)
+    pl = PointLaw(law)
+    pts, _ = points(law, 1)
+    prev = np.array([1.0, 1.0])
+    for k in range(len(ly)):
+        f = np.diag([lx[k] / prev[0], ly[k] / prev[1]])[None]
+        mp.update_finite(pts, np.zeros((1, 2)), f - np.eye(2), pl)
+        prev = np.array([lx[k], ly[k]])
+        s = pts.stress[0]
+        assert abs(s[0]) < 1e-10 * abs(s[1]) and abs(s[2]) < 1e-10 * abs(s[1])
+        assert abs(s[1]) * 2.0 * lx[k] == pytest.approx(force[k], rel=1e-10)
+        assert pts.history[0, 4] == pytest.approx(alpha[k], rel=1e-10, abs=1e-14)
+    assert alpha[1] > 0 and alpha[0] == 0  # the path yields
+    Fs = np.array([[[1.0, 0.05], [0.02, 0.97]], [[1.03, 0.1], [0.0, 0.92]],
+                   [[1.05, 0.0], [0.0, 1.05]], [[1.04, 0.01], [0.0, 1.06]]])  # fmt: skip
+    pts, _ = points(law, len(Fs))
+    mp.update_finite(pts, np.zeros((len(Fs), 2)), Fs - np.eye(2), pl)
+    kinds = set()
+    for F, sig, h in zip(Fs, pts.stress, pts.history):
+        lam, n = np.linalg.eigh(F @ F.T)
+        e, da = analytic.drucker_prager_return(np.r_[0.5 * np.log(lam), 0.0], 0.0, E, NU, *DP)
+        tau = law.K * e.sum() + 2 * law.mu * (e - e.sum() / 3)
+        want = (n * tau[:2]) @ n.T / np.linalg.det(F)
+        assert np.allclose(sig, [want[0, 0], want[1, 1], want[0, 1]], rtol=0,
+                           atol=1e-10 * np.abs(want).max())  # fmt: skip
+        assert h[4] == pytest.approx(da, rel=1e-10, abs=1e-14)
+        kinds.add("apex" if abs(tau[0] - tau[2]) < 1e-9 * abs(tau).max() else "cone")
+    assert kinds == {"apex", "cone"}
+
+
+@pytest.mark.parametrize("name", ["j2", "drucker-prager"])
+def test_plastic_tangent_is_the_consistent_one(name):
     """The Jacobian of UpdatedLaw's residual (ufl.derivative through the return mapping) against
     central differences of the residual, in a plastic state with a prestrained F_n."""
     m = dmesh.create_unit_square(MPI.COMM_SELF, 2, 2, dmesh.CellType.quadrilateral)
     V = fem.VectorFunctionSpace(m, ("Lagrange", 1))
-    law = J2Plasticity(E, NU, **J2)
+    law = J2Plasticity(E, NU, **J2) if name == "j2" else DruckerPrager(E, NU, *DP)
 
     def q(dim, value):
         e = ufl.VectorElement("Quadrature", m.ufl_cell(), 4, dim=dim, quad_scheme="default")
