@@ -64,7 +64,7 @@ OPTIONS = [  # option, type, accepted range, default, help
     ("--restitution", float, "(0, 1]", 0.05, "restitution coefficient (damping tsuji)"),
     ("--rho", float, "(0, inf)", 1.0, "density (mass per area)"),
     ("--g", float, "(0, inf)", 1.0, "gravity"),
-    ("--t-deposit", float, "(0, inf)", 20.0, "deposition time"),
+    ("--t-deposit", float, "(0, inf)", 25.0, "deposition time"),
     ("--t-compress", float, "(0, inf)", 5.0, "compression time"),
     ("--t-shear", float, "(0, inf)", 10.0, "shear time"),
     ("--compression", float, "[0, 0.2]", 0.01, "top wall travel / settled height"),

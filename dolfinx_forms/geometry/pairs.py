@@ -461,7 +461,22 @@ def closest_points(body, phi, points, length_scale, exact=True):
         return body.closest_points(points, length_scale, phi)
     if exact and has_exact_shape(body):
         return _cpp.closest_point_projection(body.shape, points, length_scale)
-    return _cpp.closest_point_projection(phi, points)
+    r = _cpp.closest_point_projection(phi, points)
+    slow = np.flatnonzero(r["status"] == int(_cpp.ProjectionStatus.max_iterations))
+    if len(slow):
+        # a point near the medial axis of a rough outline (in a grain's concave lobe) has two
+        # near-closest points and the iteration may cycle between them: it gets 500 iterations
+        # to 1e-8 h, and its last iterate is accepted if it lies on the contour (to 1e-8 h),
+        # either candidate being a closest point to that accuracy (a rough grain in a column's
+        # shear stopped a run on one such point)
+        x = np.ascontiguousarray(points[slow])
+        again = _cpp.closest_point_projection(phi, x, 1e-8, 500)
+        f, g = phi.evaluate(again["points"])[:2]
+        on = np.abs(f) <= 1e-8 * phi.grid.min_spacing * np.linalg.norm(g, axis=1)
+        again["converged"] |= on & (again["status"] == int(_cpp.ProjectionStatus.max_iterations))
+        for k in ("points", "status", "iterations", "converged"):
+            r[k][slow] = again[k]
+    return r
 
 
 @functools.lru_cache(maxsize=None)
