@@ -113,8 +113,7 @@ def main(argv=None):
             rec, p = steps.step(), sim.points[1]
             low = int(np.argmin(p.x[:, 1]))  # the lowest material point
             # the gap as the contact sees it: the floor point below the disc's centre projected
-            # on its level set's C1 interpolant (a linear crossing along a grid line is h^2 / 8R
-            # off: -4e-4 R at rest at h = 0.1, with the constraint met)
+            # on its level set's C1 interpolant (not a linear crossing along a grid line)
             c = np.average(p.x, axis=0, weights=p.vol)
             proj = _cpp.closest_point_projection(sim.levelsets[1], np.array([[c[0], 0.0]]))
             gap = proj["points"][0, 1]
