@@ -76,6 +76,9 @@ class PairGeometry:
     # (not chosen afresh) while set: `hybrid_projection`, `contact_set.ContactSet.freeze_rows`
     hybrid_rows: np.ndarray = None
     frozen_rows: np.ndarray = None
+    # contact points left out because a closest point was not found (`_Sides.quadrature`):
+    # one line each, reported by solvers.checks.pair_warnings
+    dropped: list = None
 
     @property
     def law_at_nodes(self):
@@ -512,8 +515,6 @@ class BodyLocator:
         return self.element.tabulate(0, X)[0, :, :, 0]
 
 
-
-
 def grid_locator(scene, tag, degree=1, owned_only=False):
     """The GridLocator of body `tag` of a cut scene, made once per scene (the pairs of a body
     and the material-point update share it)."""
@@ -638,10 +639,15 @@ def pair_geometry(
         length = scene.h_contact if multiplier_length is None else multiplier_length
         s = mortar_quadrature(s, sides, length, num_gauss)
         mult = multiplier_nodes(s, multipliers, length, 1e-10 * dx)
-    p_i, p_j, q = sides.quadrature(s)
+    # without multiplier nodes no other array refers to the points: a point whose closest
+    # point is not found (an iterate leaving the pair grid, a degenerate gradient) is left
+    # out and reported, not a failed step
+    s, p_i, p_j, q = sides.quadrature(s, may_drop=multipliers is None)
+    if len(s["weights"]) == 0:
+        return None
     if mult[0] is not None and traction == "nodes":
         q.set_multiplier_nodes(*mult)
-    return PairGeometry(
+    geometry = PairGeometry(
         pair,
         s["points"],
         s["weights"],
@@ -658,6 +664,8 @@ def pair_geometry(
         traction,
         multiplier_mass,
     )
+    geometry.dropped = sides.dropped
+    return geometry
 
 
 def pair_grid(bi, bj, band, dx, lattice_origin=None):
@@ -770,18 +778,27 @@ class _Sides:
                 out[at] = self.cell_label(c, points[at], p)
         return out
 
-    def quadrature(self, s):
-        """(p_i, p_j, the ContactQuadrature) of the contact points of `s`: closest points
-        (eq 25), initial gaps (eq 28), the dofs and bases at the closest points."""
+    def quadrature(self, s, may_drop=False):
+        """(s, p_i, p_j, the ContactQuadrature) of the contact points of `s`: closest points
+        (eq 25), initial gaps (eq 28), the dofs and bases at the closest points. A point whose
+        closest point on a body is not found raises RuntimeError; with may_drop (no multiplier
+        nodes refer to the points) it is left out instead and named in `self.dropped`
+        (pair_warnings reports it), and s comes back without it."""
         proj = self.project(s["points"])
+        failed = ~(proj[0]["converged"] & proj[1]["converged"])
+        self.dropped = []
         for body, pr in zip(self.bodies, proj):
-            if not np.all(pr["converged"]):
-                bad = np.flatnonzero(~pr["converged"])[0]
-                status = _cpp.ProjectionStatus(int(pr["status"][bad])).name
-                raise RuntimeError(
-                    f"closest-point projection onto body {body.name!r} failed at contact "
-                    f"point {s['points'][bad]} (status {status})"
-                )
+            for k in np.flatnonzero(~pr["converged"])[:1]:
+                status = _cpp.ProjectionStatus(int(pr["status"][k])).name
+                self.dropped.append(f"onto {body.name!r} at {s['points'][k]} ({status})")
+        if failed.any() and not may_drop:
+            raise RuntimeError(f"closest-point projection failed: {self.dropped[0]}")
+        if failed.any():
+            keep = ~failed
+            self.dropped = [f"{int(failed.sum())} points left out: {'; '.join(self.dropped)}"]
+            s = {k: (v[keep] if isinstance(v, np.ndarray) and len(v) == len(keep) else v)
+                 for k, v in s.items()}  # fmt: skip
+            proj = [{k: v[keep] for k, v in pr.items()} for pr in proj]
         p_i, p_j = proj[0]["points"], proj[1]["points"]
         normals, tangents = s["normals"], s["tangents"]
         zero = np.zeros_like(p_i)  # reference configuration: g_n = g_n0 (eq 28)
@@ -803,7 +820,7 @@ class _Sides:
             s["weights"], normals, tangents, self.g_n0, sides[0][0], sides[1][0], sides[0][1],
             sides[1][1],
         )  # fmt: skip
-        return p_i, p_j, q
+        return s, p_i, p_j, q
 
 
 def mortar_quadrature(s, sides, length, num_gauss):

@@ -51,7 +51,8 @@ MIN_NODES = 7  # multiplier nodes with pressure, below which a zone is under-res
 
 def pair_warnings(g, s, h, band, name):
     """The warnings of one pair: g its `contact.PairGeometry`, s its committed kernel state."""
-    out = []
+    dropped = getattr(g, "dropped", None) or []  # a PairGeometry, or a stand-in in tests
+    out = [f"{name}: closest-point projection failed, {d}" for d in dropped]
     active = s["state"] > 0
     if not active.any():
         return out
@@ -253,7 +254,9 @@ def free_rigid_modes(A, B, norm, centre):
         names.append(
             "x"
             if abs(t[1]) <= 1e-6
-            else "y" if abs(t[0]) <= 1e-6 else f"the translation along ({t[0]:.3g}, {t[1]:.3g})"
+            else "y"
+            if abs(t[0]) <= 1e-6
+            else f"the translation along ({t[0]:.3g}, {t[1]:.3g})"
         )
     if c_rot is not None:
         if T.shape[1] == 1:  # the rotation's centre is set up to the free translation

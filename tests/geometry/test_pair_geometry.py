@@ -243,3 +243,35 @@ def test_mass_solver_dense_and_sparse(monkeypatch):
     sparse = contact.mass_solver(rows, cols, vals, diag)(b)
     assert np.allclose(dense, x, rtol=0, atol=1e-12 * np.abs(x).max())
     assert np.allclose(sparse, x, rtol=0, atol=1e-12 * np.abs(x).max())
+
+
+def test_a_point_without_closest_point_is_left_out_and_reported(hertz, monkeypatch):
+    """A contact point whose closest point is not found (here forced: the iterate left the
+    pair grid) is left out of a pair without multiplier nodes, named in `dropped` and in the
+    pair's warnings; with P1 multiplier nodes (which refer to the points) the step fails."""
+    from dolfinx_forms.geometry import pairs as contact
+    from dolfinx_forms.solvers.checks import pair_warnings
+
+    scene, V = hertz
+    full = pair_geometry(V, scene, (0, 1), 0.2)
+    assert not full.dropped
+    real = contact.closest_points
+
+    def failing(body, phi, points, scale, exact=True):
+        r = real(body, phi, points, scale, exact)
+        if scale > 1e-2:  # the quadrature's call (h), not a label's (1e-3 h)
+            r["converged"][3], r["status"][3] = False, int(_cpp.ProjectionStatus.left_grid)
+        return r
+
+    monkeypatch.setattr(contact, "closest_points", failing)
+    g = pair_geometry(V, scene, (0, 1), 0.2)
+    assert len(g.weights) == len(full.weights) - 1 and len(g.dropped) == 1
+    assert "1 points left out" in g.dropped[0] and "left_grid" in g.dropped[0]
+    keep = np.r_[0:3, 4 : len(full.weights)]
+    np.testing.assert_array_equal(g.points, full.points[keep])
+    state = dict(state=np.zeros(len(g.weights), np.int8))
+    assert any(
+        "closest-point projection failed" in w for w in pair_warnings(g, state, 0.1, 0.2, "a-b")
+    )
+    with pytest.raises(RuntimeError, match="closest-point projection failed"):
+        pair_geometry(V, scene, (0, 1), 0.2, multipliers="P0")
