@@ -166,7 +166,7 @@ class ColumnWalls:
         return {k: f[f"{p}_normal"] for k, p in self.NAMES.items()}
 
     def vertical(self, record):
-        return -sum(record["obstacles"][p]["fy"] for p in self.NAMES.values())
+        return 0.0 - sum(record["obstacles"][p]["fy"] for p in self.NAMES.values())  # not -0.0
 
     def row(self, record, n_grains):
         """The meshes.column.row of an ImplicitMPM step record (grain pairs: not a plate's)."""
