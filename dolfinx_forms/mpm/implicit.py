@@ -78,6 +78,21 @@ def equilibrium_error(record):
     return worst / max([q["normal_force"] for q in record["pairs"]] + [1e-300])
 
 
+def _guard_jacobian(F, targets, x, F_points):
+    """In place on the MLS values F (n, 4) of the deformation gradient at `targets`: a value
+    whose det F is below half the smallest of the points' (F_points (m, 4) at x) is an
+    extrapolation artifact of a thin support (a grain's points spread by a hard impact), and
+    det F <= 0 makes the law's ln det F NaN: it takes its nearest point's F instead (that
+    point's own, det > 0). Returns how many did."""
+    det = lambda A: A[:, 0] * A[:, 3] - A[:, 1] * A[:, 2]  # noqa: E731
+    bad = np.flatnonzero(det(F) < 0.5 * det(F_points).min())
+    if len(bad):
+        from scipy.spatial import cKDTree
+
+        F[bad] = F_points[cKDTree(x).query(targets[bad])[1]]
+    return len(bad)
+
+
 def _stress_tensor(s):
     return ufl.as_matrix([[s[0], s[2]], [s[2], s[1]]])
 
@@ -329,6 +344,7 @@ class ImplicitMPM:
             points_outside_cells=outside,
             mesh_rebuilt=bool(rebuilt),
             mls_widened=mls_info["widened"],
+            mls_F_nearest=mls_info.get("F_nearest", 0),
             mass={b.name: float(self.points[b.tag].vol0.sum()) for b in self.bodies},
             volume_points={b.name: float(self.points[b.tag].vol.sum()) for b in self.bodies},
             wall_s=time.perf_counter() - t0,
@@ -531,7 +547,7 @@ class ImplicitMPM:
         extrapolated F or b_e with det <= 0 would make NaN."""
         q, qdofs = self._quadrature_function(scene, dim, field) if out is None else out
         arr = q.x.array.reshape(-1, dim)
-        widened = 0
+        widened = nearest = 0
         for t in tags:
             cells = scene.cell_tags.indices[scene.cell_tags.values == t]
             if len(cells) == 0:
@@ -548,12 +564,18 @@ class ImplicitMPM:
             r = _cpp.MLSProjector(pts.x, self.h).project(
                 values, np.ascontiguousarray(targets), self.threads
             )
+            if field == "F":
+                nearest += _guard_jacobian(r["values"], targets, pts.x, values)
             arr[qdofs[cells].ravel()] = r["values"]
             widened += int(np.sum(r["widening"] > 1))
         widened = self.comm.allreduce(widened, op=MPI.SUM)
         if widened:
             self.log(f"MLS: {widened} integration points needed a wider support (reported)")
+        nearest = self.comm.allreduce(nearest, op=MPI.SUM)
+        if nearest:
+            self.log(f"MLS: {nearest} integration points took their nearest point's F (reported)")
         info["widened"] += widened
+        info["F_nearest"] = info.get("F_nearest", 0) + nearest
         return q
 
     def _inertia(self, scene, laws, info):

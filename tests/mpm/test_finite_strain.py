@@ -210,3 +210,17 @@ def test_newton_converges_quadratically(law):
         assert np.log(r[2] / r[1]) / np.log(r[1] / r[0]) >= 1.7, r
     if law.history_size:
         assert sim.points[1].history[:, 4].max() > 0
+
+
+def test_a_projected_jacobian_below_half_the_points_takes_the_nearest_points_f():
+    """implicit._guard_jacobian: an MLS value of F whose det is below half the points'
+    smallest (an extrapolation artifact; det F <= 0 makes ln det F NaN) becomes its nearest
+    point's F; the others are left as they are."""
+    from dolfinx_forms.mpm.implicit import _guard_jacobian
+
+    x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    F_points = np.array([[1.0, 0.0, 0.0, 1.0], [0.9, 0.1, 0.0, 1.1], [1.2, 0.0, 0.05, 0.8]])
+    targets = np.array([[0.1, 0.0], [0.9, 0.1], [0.1, 0.8]])
+    F = np.array([[1.0, 0.0, 0.0, 0.95], [0.2, 0.0, 0.0, 0.3], [-0.5, 0.0, 0.0, 1.0]])
+    assert _guard_jacobian(F, targets, x, F_points) == 2
+    np.testing.assert_array_equal(F, [[1.0, 0.0, 0.0, 0.95], F_points[1], F_points[2]])
