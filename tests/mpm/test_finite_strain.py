@@ -70,13 +70,10 @@ def test_rigid_rotation_by_90_degrees_keeps_invariants_and_volumes(law):
         assert np.allclose(pts.history[:, 4], h0[:, 4], rtol=0, atol=1e-12)  # no plastic flow
 
 
-def test_j2_return_mapping_equals_the_principal_space_reference():
-    """The UFL law along the homogeneous block path (F = diag(l_x, l_y), l_x from the free side)
-    against analytic.block_j2, an independent principal-space implementation: stresses and
-    plastic strain to 1e-10 through elastic loading, yield and hardening."""
-    ly = 1 - np.linspace(0.02, 0.4, 20)
-    force, lx, alpha = analytic.block_j2(ly, 2.0, E, NU, **J2)
-    law = J2Plasticity(E, NU, **J2)
+def assert_block_path(law, ly, force, lx, alpha):
+    """One point of `law` along the homogeneous block path F = diag(l_x, l_y) (the stretches
+    of a reference): free side (sigma_xx, sigma_xy to 1e-10 of sigma_yy), the force on a block
+    2 wide and the hardening variable to 1e-10."""
     pl = PointLaw(law)
     pts, _ = points(law, 1)
     prev = np.array([1.0, 1.0])
@@ -88,6 +85,15 @@ def test_j2_return_mapping_equals_the_principal_space_reference():
         assert abs(s[0]) < 1e-10 * abs(s[1]) and abs(s[2]) < 1e-10 * abs(s[1])
         assert abs(s[1]) * 2.0 * lx[k] == pytest.approx(force[k], rel=1e-10)
         assert pts.history[0, 4] == pytest.approx(alpha[k], rel=1e-10, abs=1e-14)
+
+
+def test_j2_return_mapping_equals_the_principal_space_reference():
+    """The UFL law along the homogeneous block path (F = diag(l_x, l_y), l_x from the free side)
+    against analytic.block_j2, an independent principal-space implementation: stresses and
+    plastic strain to 1e-10 through elastic loading, yield and hardening."""
+    ly = 1 - np.linspace(0.02, 0.4, 20)
+    force, lx, alpha = analytic.block_j2(ly, 2.0, E, NU, **J2)
+    assert_block_path(J2Plasticity(E, NU, **J2), ly, force, lx, alpha)
     assert alpha[3] > 0 and alpha[0] == 0  # the path yields
 
 
@@ -100,22 +106,12 @@ def test_drucker_prager_return_mapping_equals_the_principal_space_reference():
     ly = 1 - np.linspace(0.005, 0.2, 20)
     force, lx, alpha = analytic.block_drucker_prager(ly, 2.0, E, NU, *DP)
     law = DruckerPrager(E, NU, *DP)
-    pl = PointLaw(law)
-    pts, _ = points(law, 1)
-    prev = np.array([1.0, 1.0])
-    for k in range(len(ly)):
-        f = np.diag([lx[k] / prev[0], ly[k] / prev[1]])[None]
-        mp.update_finite(pts, np.zeros((1, 2)), f - np.eye(2), pl)
-        prev = np.array([lx[k], ly[k]])
-        s = pts.stress[0]
-        assert abs(s[0]) < 1e-10 * abs(s[1]) and abs(s[2]) < 1e-10 * abs(s[1])
-        assert abs(s[1]) * 2.0 * lx[k] == pytest.approx(force[k], rel=1e-10)
-        assert pts.history[0, 4] == pytest.approx(alpha[k], rel=1e-10, abs=1e-14)
+    assert_block_path(law, ly, force, lx, alpha)
     assert alpha[1] > 0 and alpha[0] == 0  # the path yields
     Fs = np.array([[[1.0, 0.05], [0.02, 0.97]], [[1.03, 0.1], [0.0, 0.92]],
                    [[1.05, 0.0], [0.0, 1.05]], [[1.04, 0.01], [0.0, 1.06]]])  # fmt: skip
     pts, _ = points(law, len(Fs))
-    mp.update_finite(pts, np.zeros((len(Fs), 2)), Fs - np.eye(2), pl)
+    mp.update_finite(pts, np.zeros((len(Fs), 2)), Fs - np.eye(2), PointLaw(law))
     kinds = set()
     for F, sig, h in zip(Fs, pts.stress, pts.history):
         lam, n = np.linalg.eigh(F @ F.T)
