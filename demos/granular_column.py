@@ -74,7 +74,8 @@ NEWTON = NewtonOptions(max_cutbacks=1)
 
 def parse(argv):
     p = cli.demo_parser("granular_column.py", __doc__, "results/granular_column", OPTIONS,
-                        discretization=False, multi_step=True)  # fmt: skip
+                        discretization=False, multi_step=True,
+                        levelset_update="reference-map")  # fmt: skip
     a = p.parse_args(argv)
     if not (3 <= a.radius * (1 - a.polydispersity) / a.h and a.radius / a.h <= 50):
         p.error(f"--h: the smallest radius / h must be >= 3 and radius / h <= 50, got {a.h}")

@@ -428,13 +428,14 @@ def demo_parser(
     cells=None,
     enforcement=("penalty", "augmented"),
     multi_step=False,
+    levelset_update=None,
 ):
     """A demo's parser: the description is the first paragraph of `doc`; --out (default `out`)
     and --force, --discretization and --ghost-penalty (add_discretization), the `options`
     table (add_options), --quads/--triangles (add_cells, with cells = (quads by default,
     help of --quads, help of --triangles)), --enforcement with the `enforcement` choices,
     --linear-solver, --petsc (add_petsc). multi_step: a demo of the MPM (MPM_ENFORCEMENT, and
-    --eps0 checked by check_mpm_eps0)."""
+    --eps0 checked by check_mpm_eps0, --levelset-update with the default `levelset_update`)."""
     p = DemoParser(prog=prog, description=doc.split("\n\n")[0])
     p._multi_step = multi_step
     enforcement = MPM_ENFORCEMENT if multi_step else enforcement
@@ -448,7 +449,27 @@ def demo_parser(
         add_enforcement(p, enforcement)
         add_linear_solver(p)
         add_petsc(p)
+    if multi_step:
+        add_levelset_update(p, levelset_update)
     return p
+
+
+def add_levelset_update(parser, default=None):
+    """--levelset-update of the multi-step demos: how the bodies' level sets follow them
+    (mpm/evolution.py; default its first choice)."""
+    from dolfinx_forms.mpm.evolution import LEVELSET_UPDATES
+
+    parser.add_argument(
+        "--levelset-update",
+        choices=list(LEVELSET_UPDATES),
+        default=default or LEVELSET_UPDATES[0],
+        help=(
+            "how the level sets follow the bodies: advection (the paper's eq 19, HJ-WENO5 with "
+            "the extended increment: follows the FE increment, drifts from the points over "
+            "many steps), reference-map (phi_0 at the MLS fit of the points' reference "
+            "positions: no drift, smooths the increment over about h)"
+        ),
+    )
 
 
 def check_scale(parser, args, size, what, max_cells=2000, displacement=True):
@@ -465,8 +486,6 @@ def check_scale(parser, args, size, what, max_cells=2000, displacement=True):
             f"--displacement: must be <= {0.1 * size:g} mm (a tenth of the {size:g} mm {what}: "
             f"small strain), got {args.displacement}"
         )
-
-
 
 
 # the multi-step MPM's --enforcement choices: the penalty, or the augmented Lagrangian (its

@@ -42,6 +42,7 @@ PROBLEM_OPTIONS = {
     "enforcement": "enforcement",
     "multiplier_mass": "multiplier_mass",
     "linear_solver": "linear_solver",
+    "levelset_update": "levelset_update",  # the multi-step demos (ImplicitMPM)
 }
 
 

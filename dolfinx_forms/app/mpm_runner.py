@@ -263,6 +263,7 @@ def make_simulation(spec, comm, timer=None, log=print):
         obstacles=list(obstacles.values()),
         dirichlet=list(dirichlet.values()),
         reinit_drift=s["reinit_drift"],
+        levelset_update=s["levelset_update"],
         dynamics=dyn,
         timer=timer,
         log=log,

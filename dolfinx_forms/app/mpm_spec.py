@@ -13,7 +13,8 @@ in brackets; lengths and forces in the scene's units, angles in degrees):
       the penalty in [1e-4, 1], cli.MPM_EPS0; augmented: the loop's speed, [1e-4, 1e4]), band
       [2 h; doubled while active points reach its edge], ghost_penalty [0.01], grid_refine
       [4], num_gauss [2], linear_solver ["auto"], petsc {KEY = VALUE}, newton {rtol, ftol,
-      atol, stol, max_iterations, max_cutbacks}, predictor_gap [0], reinit_drift [0.2]
+      atol, stol, max_iterations, max_cutbacks}, predictor_gap [0], levelset_update
+      ["advection"] or "reference-map" (mpm/evolution.py), reinit_drift [0.2]
   [dynamics]  (optional: inertia, each stage step a time step; mpm/dynamics.py PointNewmark)
       dt, integrator ["dissipative"] or "trapezoidal", gravity [[0, 0]] (per unit mass),
       viscosity [0] (Kelvin-Voigt eta: spares rigid motions), mass_damping [0] (Rayleigh's
@@ -53,6 +54,7 @@ import copy
 
 import numpy as np
 
+from dolfinx_forms.mpm.evolution import LEVELSET_UPDATES
 from dolfinx_forms.app.spec_values import (
     SpecError,
     Table,
@@ -123,6 +125,9 @@ def _solver(t):
         grid_refine=t.integer("grid_refine", 4, lo=1, hi=16),
         num_gauss=t.integer("num_gauss", 2, lo=1, hi=5),
         predictor_gap=t.number("predictor_gap", 0.0, lo=0),
+        levelset_update=t.string(
+            "levelset_update", LEVELSET_UPDATES[0], choices=list(LEVELSET_UPDATES)
+        ),
         reinit_drift=t.number("reinit_drift", 0.2, lo=0, lo_open=True),
         linear_solver=t.string(
             "linear_solver", "auto", choices=["auto", "condensed", "factorised", "iterative"]

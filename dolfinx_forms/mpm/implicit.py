@@ -104,7 +104,8 @@ class ImplicitMPM:
     cut scene of {tag: _cpp.LevelSet} on that grid (bodies in the order of `bodies`); obstacles:
     `RigidObstacle`s with their motion per step; dirichlet: `Dirichlet` conditions whose values
     are the increments of one step (at lam = 1); reinit_drift: reinitialise a level set when
-    max | |grad phi| - 1 | within 3 h of its zero contour exceeds it. Other keywords go to
+    max | |grad phi| - 1 | within 3 h of its zero contour exceeds it; levelset_update:
+    "advection" (eq 19) or "reference-map" (the points' map, `evolution.py`). Other keywords go to
     `ContactProblem` (mu, eps0, band, newton, petsc_options, ghost_penalty, ...)."""
 
     def __init__(
@@ -117,6 +118,7 @@ class ImplicitMPM:
         obstacles=(),
         dirichlet=(),
         reinit_drift=0.2,
+        levelset_update=evolution.LEVELSET_UPDATES[0],
         dynamics=None,
         timer=None,
         log=print,
@@ -156,6 +158,9 @@ class ImplicitMPM:
         self.obstacles = list(obstacles)
         self.dirichlet = list(dirichlet)
         self.reinit_drift = float(reinit_drift)
+        if levelset_update not in evolution.LEVELSET_UPDATES:
+            raise ValueError(f"levelset_update must be one of {evolution.LEVELSET_UPDATES}")
+        self.levelset_update = levelset_update
         self.dynamics = dynamics  # None: quasi-static; a mpm.dynamics.PointNewmark
         self.timer = timer
         self.threads = worker_threads(comm)

@@ -51,6 +51,7 @@ class MaterialPoints:
     history: np.ndarray = None  # (n, k) the law's history (finite_strain.py)
     v: np.ndarray = None  # (n, 2) velocity (dynamics.py; zero when seeded)
     a: np.ndarray = None  # (n, 2) acceleration
+    X: np.ndarray = None  # (n, 2) reference position (x when seeded): the reference map
 
     def __post_init__(self):
         if self.v is None:
@@ -61,6 +62,8 @@ class MaterialPoints:
             self.F = np.tile(np.eye(2), (len(self.vol0), 1, 1))
         if self.history is None:
             self.history = np.zeros((len(self.vol0), 0))
+        if self.X is None:
+            self.X = self.x.copy()
 
     def __len__(self):
         return len(self.vol0)
@@ -71,7 +74,7 @@ class MaterialPoints:
             *(
                 a.copy()
                 for a in (self.x, self.vol0, self.vol, self.stress, self.F, self.history, self.v,
-                          self.a)
+                          self.a, self.X)
             ),
         )
 

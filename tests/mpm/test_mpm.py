@@ -85,14 +85,16 @@ def test_levelset_windows_follow_a_translated_disc():
     for _ in range(3):
         sim.step()
     i0, i1, j0, j1 = sim.windows[1]
-    # grew along the motion (the last advection: 6 cells past the disc moved by 6 cells plus
-    # the 3 of its step), by the evolution's margin across it
+    # grew along the motion (the last step: 6 cells past the disc moved by 6 cells plus the 3
+    # of its step), by the evolution's margin across it (and a row more on either side: the
+    # contour passes through grid nodes, where phi = +-1e-17 decides whether a cell is active)
     assert i0 <= w0[0] and i1 >= w0[1] + 6 and j0 <= w0[2] and j1 >= w0[3]
-    assert (j1 - j0) - (w0[3] - w0[2]) <= 4
+    assert (j1 - j0) - (w0[3] - w0[2]) <= 6
     full = sim.levelset_values(1)
     assert np.array_equal(full[j0 : j1 + 1, i0 : i1 + 1], sim.levelsets[1].values)
     assert np.all(full[:, i1 + 1 :] > 0)
-    # the disc moved by 3 d: the contour follows it to the advection's accuracy
+    # the disc moved by 3 d: the contour follows it (the reference map: 0.007 h; advected,
+    # 0.03 h)
     t = np.linspace(0, 2 * np.pi, 40)
     ring = np.array([-1.5, 0.0]) + 3 * d + r * np.stack([np.cos(t), np.sin(t)], axis=1)
     assert np.max(np.abs(sim.levelsets[1].evaluate(ring)[0])) < 0.05 * h
