@@ -466,7 +466,8 @@ def add_levelset_update(parser, default=None):
         help=(
             "how the level sets follow the bodies: advection (the paper's eq 19, HJ-WENO5 with "
             "the extended increment: follows the FE increment, drifts from the points over "
-            "many steps), reference-map (phi_0 at the MLS fit of the points' reference "
+            "many steps), flow (advection by the velocity whose flow is the step's map x + du "
+            "to second order: no drift under rotation), reference-map (phi_0 at the MLS fit of the points' reference "
             "positions: no drift, smooths the increment over about h)"
         ),
     )

@@ -14,7 +14,7 @@ in brackets; lengths and forces in the scene's units, angles in degrees):
       [2 h; doubled while active points reach its edge], ghost_penalty [0.01], grid_refine
       [4], num_gauss [2], linear_solver ["auto"], petsc {KEY = VALUE}, newton {rtol, ftol,
       atol, stol, max_iterations, max_cutbacks}, predictor_gap [0], levelset_update
-      ["advection"] or "reference-map" (mpm/evolution.py), reinit_drift [0.2]
+      ["advection"], "flow" or "reference-map" (mpm/evolution.py), reinit_drift [0.2]
   [dynamics]  (optional: inertia, each stage step a time step; mpm/dynamics.py PointNewmark)
       dt, integrator ["dissipative"] or "trapezoidal", gravity [[0, 0]] (per unit mass),
       viscosity [0] (Kelvin-Voigt eta: spares rigid motions), mass_damping [0] (Rayleigh's
