@@ -143,6 +143,7 @@ BAD = [  # (override, the key the message names, a word of the message)
     ("dynamics={dt=0.1, gravity=[0.0, -1.0, 0.0]}", "dynamics.gravity", "[gx, gy]"),
     ("dynamics={dt=0.1, damping=1.0}", "dynamics.damping", "unknown"),
     ("bodies[0].rho=-1.0", "bodies[0].rho", "> 0"),
+    ("solver.levelset_update='weno'", "solver.levelset_update", "reference-map"),
 ]  # fmt: skip
 
 
@@ -157,6 +158,10 @@ def test_bad_description_names_the_key(override, key, word):
 def test_base_description_is_valid():
     spec = load(BASE)
     assert spec["solver"]["band"] is None and spec["stages"][0]["move"]["floor"]["rotation"] == 0
+    assert spec["solver"]["levelset_update"] == "advection"
+    assert load(BASE, ["solver.levelset_update='reference-map'"])["solver"]["levelset_update"] == (
+        "reference-map"
+    )
 
 
 def test_bad_description_on_the_command_line(tmp_path):
