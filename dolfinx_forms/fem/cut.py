@@ -78,15 +78,18 @@ def _mixed_form(ufl_form, replace, subdomains):
     return form, module
 
 
-def shape_values(shape, points):
+def shape_values(shape, points, clamp=False):
     """Values (n,) at points (n, 2) of a body's cut level set: a shape (callable, e.g. a
-    `_cpp.Shape`) or a grid `_cpp.LevelSet` (its C1 interpolant; node values at grid nodes)."""
+    `_cpp.Shape`) or a grid `_cpp.LevelSet` (its C1 interpolant; node values at grid nodes).
+    clamp: a grid level set is evaluated at the nearest point of its grid for points beyond it
+    (a body's level set is positive there; the reference map asks anywhere), not only for those
+    off its edge by round-off."""
     points = np.ascontiguousarray(points, dtype=float)
     if isinstance(shape, _cpp.LevelSet):
         g = shape.grid  # dof coordinates on the grid's edge may be off by round-off: clip those
         lo = np.array([g.x[0], g.y[0]])
         hi = np.array([g.x[-1], g.y[-1]])
-        tol = 1e-9 * np.max(hi - lo)
+        tol = np.inf if clamp else 1e-9 * np.max(hi - lo)
         near = np.all((points[:, :2] >= lo - tol) & (points[:, :2] <= hi + tol), axis=1)
         p = points[:, :2].copy()
         p[near] = np.clip(p[near], lo, hi)
