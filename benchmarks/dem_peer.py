@@ -8,8 +8,9 @@ What is compared, per seed (--seeds) and Young's modulus (--E): the stress ratio
 forces, the coordination number, the grain-grain normal forces' mean and coefficient of
 variation. summary.json: their mean and standard deviation (ddof 1) over the seeds at the end of
 compression and of shear, each LAMMPS run's wall time, the LAMMPS version; dem_peer.png: the DEM
-mean with a +-1 std band against the shear strain (shear phase) and the time (all phases), each
---mpm result folder of demos/granular_column.py a line.
+mean with a +-1 std band against the shear strain (shear phase) and the time (all phases), and
+the --mpm result folders of demos/granular_column.py grouped by their --E, each group a dashed
+line with its own band over the runs.
 
 The LAMMPS model: 2D, atom_style sphere, mass rho pi r^2 (`set density/disc`), a disc's inertia
 (`fix nve/sphere disc`). Contacts: `pair_coeff * * hertz/material E e nu tangential mindlin NULL
@@ -265,6 +266,32 @@ def spread(values):
         return mean, np.nanstd(v, axis=0, ddof=1) if len(v) > 1 else np.zeros_like(mean)
 
 
+def mpm_curves(folders, dt=0.1):
+    """The MPM runs (demos/granular_column.py result folders) grouped by their --E: per group
+    the mean and spread over the runs (as for the DEM's seeds) of each run's rows sampled every
+    `dt` (the last accepted step at or before each time: the runs' adaptive steps differ)."""
+    groups = {}
+    for d in map(Path, folders):
+        with open(d / "steps.csv") as f:
+            rows = list(csv.DictReader(f))
+        s = {k: np.array([q[k] if k == "phase" else q[k] or "nan" for q in rows]) for k in rows[0]}
+        s = {k: v if k == "phase" else v.astype(float) for k, v in s.items()}  # "": no ratio
+        meta = d / "metrics.json"
+        E = json.loads(meta.read_text()).get("parameters", {}).get("E") if meta.exists() else None
+        groups.setdefault(E, []).append(s)
+    curves = []
+    for E, runs in groups.items():
+        t = np.arange(0.0, min(s["t"][-1] for s in runs) + 1e-9, dt)
+        at = [np.maximum(np.searchsorted(s["t"], t + 1e-9, side="right") - 1, 0) for s in runs]
+        c = {k: runs[0][k][at[0]] for k in ("phase", "shear_strain")}
+        c["t"], std = t, {}
+        for key in METRICS[:2]:
+            c[key], std[key] = spread([s[key][i] for s, i in zip(runs, at)])
+        label = f"MPM E={E:g}" if E is not None else "MPM"
+        curves.append((f"{label} ({len(runs)} runs)", c, std if len(runs) > 1 else None))
+    return curves
+
+
 def plot(path, dem, mpm):
     """dem_peer.png: stress ratio and coordination against shear strain and time."""
     import matplotlib
@@ -278,21 +305,15 @@ def plot(path, dem, mpm):
         for key in METRICS[:2]:
             s[key], std[key] = spread([[q[key] for q in rows] for rows in runs])
         curves.append((f"LAMMPS E={E:g} ({len(runs)} seeds)", s, std))
-    for d in map(Path, mpm):
-        with open(d / "steps.csv") as f:
-            rows = list(csv.DictReader(f))
-        s = {k: np.array([q[k] if k == "phase" else q[k] or "nan" for q in rows]) for k in rows[0]}
-        s = {k: v if k == "phase" else v.astype(float) for k, v in s.items()}  # "": no ratio
-        meta = d / "metrics.json"
-        E = json.loads(meta.read_text()).get("parameters", {}).get("E") if meta.exists() else None
-        curves.append((f"MPM E={E:g}" if E is not None else f"MPM {d.name}", s, None))
+    curves += mpm_curves(mpm)
     fig, ax = plt.subplots(2, 2, figsize=(11, 7))
     top = 0.0  # the stress ratio's axis: after deposition (it diverges in the free fall)
     for label, s, std in curves:
         for i, key in enumerate(METRICS[:2]):
             band = std[key] if std else 0 * s[key]
             for j, (x, m) in enumerate(((s["shear_strain"], s["phase"] == "shear"), (s["t"], ...))):
-                line = ax[i, j].plot(x[m], s[key][m], "-" if std else "--", label=label)
+                style = "--" if label.startswith("MPM") else "-"
+                line = ax[i, j].plot(x[m], s[key][m], style, label=label)
                 ax[i, j].fill_between(x[m], (s[key] - band)[m], (s[key] + band)[m],
                                       color=line[0].get_color(), alpha=0.25, lw=0)  # fmt: skip
         later = s["phase"] != "deposition"
