@@ -66,8 +66,7 @@ OPTIONS = [  # option, kind, default[, help]
     ("--series-every", range(1, 10001), 50, "steps between frames of the time series"),
 ]
 COLUMNS = column.COLUMNS + ["dt", "newton_iterations", "retries", "wall_s"]
-# a step whose contacts cycle is done again at half dt: cutting the load level within it does
-# not help (20 grains, 6 time units: the same run in 87 s, not 106 s with 6 cut-backs)
+# a failed step is done again at half dt; cutting its load level does not help (87 s, not 106)
 NEWTON = NewtonOptions(max_cutbacks=1)
 # fmt: on
 

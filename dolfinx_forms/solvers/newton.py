@@ -141,20 +141,14 @@ def newton(problem, lam, r_ref=0.0, early=0.0):
         # live on the ranks that hold the pairs: the set compared is the union over the ranks
         # (one rank's part can repeat while another's changes).
         sig = tuple(problem.comm.allgather(problem.contact.signature()))
+        cycling = any(sig) and sig in seen and r >= 0.999 * seen[sig]
         # Line search: a step that keeps the active set but does not lower the residual (the
         # slip law's curvature) is halved, u = u_base + alpha du. A step that changes the active
-        # set is taken whole: the semismooth Newton's residual need not fall monotonically.
-        if opts.line_search and r_base is not None and r > r_base and sig == sig_base:
-            if backtracks < opts.max_backtracks and it < opts.max_iterations:
-                backtracks += 1
-                problem.u.x.array[:] -= 0.5**backtracks * problem.du.x.array
-                if problem.control is not None:
-                    problem.control.backtrack(0.5**backtracks)
-                continue
-        cycling = any(sig) and sig in seen and r >= 0.999 * seen[sig]
-        # a cycle: the full step jumped back to an active set seen before. Damp it as the line
-        # search does, across the change of the active set, before giving up
-        if cycling and opts.damp_cycles and r_base is not None:
+        # set is taken whole: the semismooth Newton's residual need not fall monotonically;
+        # unless it jumped back to an active set seen before (a cycle, damp_cycles): halved too,
+        # across the change, before giving up
+        worse = opts.line_search and r_base is not None and r > r_base and sig == sig_base
+        if worse or (cycling and opts.damp_cycles and r_base is not None):
             if backtracks < opts.max_backtracks and it < opts.max_iterations:
                 backtracks += 1
                 problem.u.x.array[:] -= 0.5**backtracks * problem.du.x.array
