@@ -159,6 +159,13 @@ def parse(argv):
         f"{','.join(map(str, QUICK_GETFEM_DIVISORS))})",
     )
     p.add_argument(
+        "--R",
+        type=float,
+        default=HERTZ_DEFAULTS["R"],
+        help=f"cylinder radius (default {HERTZ_DEFAULTS['R']:g}; the GetFEM comparison runs at "
+        "the default only)",
+    )
+    p.add_argument(
         "--reference-divisor",
         type=float,
         default=None,
@@ -167,6 +174,8 @@ def parse(argv):
         "measured against it; 0: no reference",
     )
     a = p.parse_args(argv)
+    if not (math.isfinite(a.R) and a.R > 0):
+        p.error(f"--R must be in (0, inf), got {a.R:g}")
     if a.reference_divisor is None:
         a.reference_divisor = QUICK_REFERENCE_DIVISOR if a.quick else REFERENCE_DIVISOR
     if not (
@@ -226,11 +235,11 @@ def code_digest():
     return h.hexdigest()[:12]
 
 
-def hertz_half_width():
-    return study.hertz_reference()[0]
+def hertz_half_width(R=HERTZ_DEFAULTS["R"]):
+    return study.hertz_reference(dict(R=R))[0]
 
 
-def run_one(variant, divisor, h, timeout):
+def run_one(variant, divisor, h, timeout, R=HERTZ_DEFAULTS["R"]):
     """One demo run in a scratch folder; returns the run record (ok or failed)."""
     rec = dict(
         variant=variant,
@@ -240,7 +249,7 @@ def run_one(variant, divisor, h, timeout):
         code_sha256=code_digest(),
     )
     with tempfile.TemporaryDirectory(prefix="work_precision_keep.") as keep:
-        rec.update(demo.run_hertz(h, VARIANTS[variant], timeout, keep=keep))
+        rec.update(demo.run_hertz(h, VARIANTS[variant], timeout, keep=keep, case=dict(R=R)))
         if rec.get("ok"):
             rec["_profile"] = read_profile(Path(keep) / "tractions.csv")
     return rec
@@ -465,7 +474,9 @@ def summarize(variant, runs):
     ok_h = sorted(ok, key=lambda r: -r["h"])  # coarse to fine
     hs = [r["h"] for r in ok_h]
     rates, monotone = {}, {}
-    for k in ERRORS:
+    # against Hertz, and where every run has them against the circle and the fine reference
+    extra = [k for k in (study.CIRCLE_ERROR, REF_KEY) if ok and all(k in r["errors"] for r in ok)]
+    for k in (*ERRORS, *extra):
         errs = [r["errors"][k] for r in ok_h]
         rates[k] = loglog_rate(hs, errs)
         monotone[k] = study.decreasing(errs)
@@ -892,7 +903,9 @@ def report(data):
         print(
             f"{v}: rates vs h: a {fmt(rt['half_width_rel_error'], '.2f')}, "
             f"p0 {fmt(rt['peak_pressure_rel_error'], '.2f')}, "
-            f"p L2 {fmt(rt['pressure_rel_l2_error'], '.2f')}; "
+            f"p L2 {fmt(rt['pressure_rel_l2_error'], '.2f')} "
+            f"(vs circle {fmt(rt.get(study.CIRCLE_ERROR), '.2f')}, "
+            f"vs reference {fmt(rt.get(REF_KEY), '.2f')}); "
             f"time to {100 * TARGET:g} %: "
             + (f"{tt['time_s']:.2f} s ({tt['method']})" if tt["reached"] else tt["method"])
         )
@@ -964,11 +977,13 @@ def main(argv=None):
     except OSError as e:
         sys.stderr.write(f"work_precision.py: error: --out-dir: cannot create {out_dir}: {e}\n")
         return 2
-    a = hertz_half_width()
+    a = hertz_half_width(args.R)
     git = git_head()
     load0 = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
     if args.no_getfem:
         with_getfem, why = False, "--no-getfem"
+    elif args.R != HERTZ_DEFAULTS["R"]:
+        with_getfem, why = False, f"getfem_hertz.py solves R = {HERTZ_DEFAULTS['R']:g} only"
     else:
         with_getfem, why = getfem_available()
     if not with_getfem:
@@ -990,7 +1005,7 @@ def main(argv=None):
             rec = run_getfem(k, h, args.timeout)
             getfem_runs.append(rec)
         else:
-            rec = run_one(v, k, h, args.timeout)
+            rec = run_one(v, k, h, args.timeout, args.R)
             runs.append(rec)
         if rec["ok"]:
             print(
@@ -1005,7 +1020,7 @@ def main(argv=None):
         k = args.reference_divisor
         k = int(k) if float(k).is_integer() else k
         print(f"[work_precision] fine reference {REFERENCE_VARIANT} h = a/{k} ...", flush=True)
-        ref = run_one(REFERENCE_VARIANT, k, a / k, args.timeout)
+        ref = run_one(REFERENCE_VARIANT, k, a / k, args.timeout, args.R)
         reference = {key: ref.get(key) for key in ("variant", "h_divisor", "h", "ok", "error")}
         if ref["ok"]:
             reference.update(
@@ -1025,7 +1040,7 @@ def main(argv=None):
     data = dict(
         benchmark="hertz work-precision (frictionless, demos/hertz.py defaults)",
         a_hertz=a,
-        hertz_defaults=HERTZ_DEFAULTS,
+        hertz_defaults=dict(HERTZ_DEFAULTS, R=args.R),
         h_divisors=list(args.divisors),
         variants=args.variants,
         variant_args={v: VARIANTS[v] for v in args.variants},

@@ -38,6 +38,12 @@ __all__ = [
     "write_study",
     "CASE",
     "VARIANTS",
+    "BULKS",
+    "PATHS",
+    "ENFORCEMENTS",
+    "VARIANT",
+    "bulk_args",
+    "CONVERGENCE_DEFINITIONS",
     "ERRORS",
     "CIRCLE_ERROR",
     "ERROR_LABELS",
@@ -328,7 +334,38 @@ VARIANTS = {  # name -> hertz.py arguments selecting the discretisation
     # a/32: 1.03 / 0.86 / 0.80 / 0.66 % against 1.06 / 0.91 / 0.79 / 0.67 % with the demo's
     # zone 1.2 a and slope 0.25, at 2/3 of the dofs)
     "p1-tri-layers": ["--mesher", "layers", "--zone", "1.0", "--grading", "0.5"],
+    # the augmented Lagrangian as hertz.py runs it (the hybrid projection) on p1-tri's and
+    # q1-cut's meshes: demos/convergence_study.py's augmented runs
+    "p1-tri-aug": ["--mesher", "gmsh", "--enforcement", "augmented"],
+    "q1-cut-aug": ["--discretization", "cut", "--enforcement", "augmented"],
 }
+# the bulk of a convergence study (demos/convergence_study.py --bulk): hertz.py's own meshes
+# ("demo": the size grows away from the contact up to 100 h, a 40 a x 20 a block), or a bulk
+# whose error stays below the contact's down to a/80 ("resolved": cells at most a/4 anywhere
+# near, an 80 a x 40 a block; at R = 40, a/80, body-fitted, a finer bulk moves the augmented
+# p(x) error by 0.004 %). With the demo's bulk the far cells make the bodies too stiff (a
+# narrower, higher pressure), which the penalty's compliance hides and the augmented
+# Lagrangian does not: at R = 40 the augmented error levels off at 0.41 % from a/80 on there
+# (0.26 % with the resolved bulk, falling at rate 0.96 from a/20; docs/demos/convergence_study.md)
+BULKS = ("resolved", "demo")
+PATHS, ENFORCEMENTS = ("conforming", "cut"), ("penalty", "augmented")
+# demos/convergence_study.py's variant of each path and enforcement
+VARIANT = {
+    ("conforming", "penalty"): "p1-tri",
+    ("cut", "penalty"): "q1-cut",
+    ("conforming", "augmented"): "p1-tri-aug",
+    ("cut", "augmented"): "q1-cut-aug",
+}
+
+
+def bulk_args(bulk, a, h, cut):
+    """hertz.py arguments of the bulk `bulk` (BULKS) for Hertz half-width a and contact size h."""
+    if bulk == "demo":
+        return []
+    sizes = ["--width", repr(80 * a), "--depth", repr(40 * a), "--h-far", repr(max(a / 4, h))]
+    return sizes + (["--grading", "1.5"] if cut else [])
+
+
 ERROR_LABELS = {
     "half_width_rel_error": "a",
     "peak_pressure_rel_error": "p0",
@@ -346,15 +383,33 @@ RELATIVE = {
 HERTZ_PARAMETERS = "discretization degree quads eps0 ghost_penalty grid_refine gauss width depth"
 
 
+# the measures of demos/convergence_study.py's convergence.json
+CONVERGENCE_DEFINITIONS = dict(
+    errors_definition=dict(
+        half_width_rel_error="|a - a_H| / a_H, a: half the distance between the zeros of the "
+        "interpolated gap at the two ends of the active zone, a_H: Hertz at the computed load",
+        peak_pressure_rel_error="|p0 - p0_H| / p0_H, p0: the largest point pressure",
+        pressure_rel_l2_error="||p - p_H|| / ||p_H|| over the contact points "
+        "(results.pressure_rel_l2_error of metrics.json)",
+        pressure_rel_l2_error_circle="||p - p_C|| / ||p_C||, p_C: the circle's pressure to "
+        "O((a/R)^4) at the computed load (analytic.circle_pressure; "
+        "results.pressure_rel_l2_error_circle)",
+    ),
+    rates_definition="rates_vs_h: least-squares slope of log(error) vs log(h) over the "
+    "successful runs (positive: converging); local_rates_vs_h: the slope between consecutive sizes",
+)
+
+
 def variant_path(variant):
     """'cut' or 'conforming': the discretisation path of a variant."""
     return "cut" if "cut" in VARIANTS[variant] else "conforming"
 
 
-def hertz_reference():
-    """Hertz half-width and peak pressure of CASE (at the requested load)."""
-    E_star = analytic.effective_modulus(CASE["E"], CASE["nu"], CASE["E"], CASE["nu"])
-    a, p0 = analytic.hertz_line(CASE["load"], CASE["R"], E_star)
+def hertz_reference(case=None):
+    """Hertz half-width and peak pressure of CASE (updated with `case`) at the requested load."""
+    c = {**CASE, **(case or {})}
+    E_star = analytic.effective_modulus(c["E"], c["nu"], c["E"], c["nu"])
+    a, p0 = analytic.hertz_line(c["load"], c["R"], E_star)
     return float(a), float(p0)
 
 
@@ -367,15 +422,17 @@ def hertz_errors(m):
     return dict(hertz_parameters=settings, **run_summary(m), **errors)
 
 
-def run_hertz(script, h, variant_args=(), timeout=None, keep=None):
+def run_hertz(script, h, variant_args=(), timeout=None, keep=None, case=None):
     """Run the Hertz demo `script` (demos/hertz.py: the caller names it, the package does not
-    know the repository's scripts) on CASE, mesh size h at the contact, extra arguments, in its
-    own process (run_demo, from the script's repository); `keep`: a folder that receives its
-    metrics.json and tractions.csv."""
+    know the repository's scripts) on CASE (updated with `case`), mesh size h at the contact,
+    extra arguments, in its own process (run_demo, from the script's repository); `keep`: a
+    folder that receives its metrics.json and tractions.csv."""
     script = Path(script).resolve()
     root = script.parents[1]
-    args = ["--h", repr(h), *(a for k, v in CASE.items() for a in (f"--{k}", repr(v)))]
+    c = {**CASE, **(case or {})}
+    args = ["--h", repr(h), *(a for k, v in c.items() for a in (f"--{k}", repr(v)))]
     args = [*args, *variant_args]
-    rec = run_demo(script.relative_to(root), args, cwd=root, evaluate=hertz_errors,
-                   timeout=timeout, keep=keep)
+    rec = run_demo(
+        script.relative_to(root), args, cwd=root, evaluate=hertz_errors, timeout=timeout, keep=keep
+    )
     return dict(h=h, **rec)
