@@ -72,8 +72,11 @@ fit).
 Usage: /usr/bin/python3 benchmarks/work_precision.py [--quick] [--variants p1-tri,q1-cut,...]
                                                      [--out-dir benchmarks/results] [--timeout S]
                                                      [--no-getfem] [--getfem-divisors 5,...,56]
+                                                     [--R 10]
   --quick: a/10, a/14, a/20 only (default variants p1-tri,q1-cut; GetFEM a/7, a/10, a/14,
-  a/20), a smoke run of ~1 minute.
+  a/20), a smoke run of ~1 minute. --R: the cylinder's radius (GetFEM runs at 10 only); each
+  variant's rates in h are reported against Hertz, the circle and the fine reference
+  (p1-tri-aug and q1-cut-aug: the augmented Lagrangian as hertz.py runs it, hybrid projection).
 """
 
 import hashlib
