@@ -5,7 +5,7 @@ case it was tuned on and on a case it was not, side by side.
 The tuned case: Hertz (demos/hertz.py) at R = 10 mm, h = a/20, both paths. The check case:
 the same at R = 40 mm (a about twice as wide, h = a/20 of it: another mesh, another load per
 unit length of contact). Normal factors (pointwise_eps0, consistent_eps0, consistent_length,
-hybrid_closed_fraction): the augmented Lagrangian's p(x) L2 error against Hertz and against
+hybrid_closed_fraction, edge_offset): the augmented Lagrangian's p(x) L2 error against Hertz and against
 the circle. Tangential factors (pointwise_eps0_t, consistent_eps0_t): Cattaneo-Mindlin
 (--tangential 0.5 --mu 0.3), the stick half-width's relative error and q(x)'s L2 error.
 augmented_eps0: the Uzawa updates (its only effect: the answer does not depend on it).
@@ -42,6 +42,7 @@ SWEEPS = {
     "hybrid_closed_fraction": ([0.5, 0.75, 1.0], AUGMENTED, "normal"),
     "pointwise_eps0_t": ([1.25, 1.5, 2.0], [*LUMPED, *MINDLIN], "tangential"),
     "consistent_eps0_t": ([0.75, 1.0, 1.5], [*AUGMENTED, *MINDLIN], "tangential"),
+    "edge_offset": ([0.0, 0.15, 0.27, 0.4, 0.5], AUGMENTED, "normal"),
     "augmented_eps0": ([1e-2, 1.0, 1e2], AUGMENTED, "speed"),
 }
 CASES = {"tuned R=10": ["--R", "10"], "check R=40": ["--R", "40"]}

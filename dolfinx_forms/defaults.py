@@ -31,6 +31,9 @@ class Tuning:
     # the hybrid projection: a node whose hat has this fraction of its weight on closed points
     # gets the consistent row, the others the lumped one
     hybrid_closed_fraction: float = 0.75
+    # the P1 multiplier nodes aligned with the contact zones (`NewtonOptions.al_align`): the
+    # first node outside a contact edge lies this fraction of a multiplier element past it
+    edge_offset: float = 0.27
     # the demos' --eps0 with --enforcement augmented (it sets the Uzawa step only)
     augmented_eps0: float = 1e-2
     # linear solves: "auto" condenses the bulk where m^3 <= condensed_cost n^1.5
@@ -51,6 +54,7 @@ STUDIES = {
     "pointwise_eps0_t": "benchmarks/calibration.py --constant pointwise_eps0_t",
     "consistent_eps0_t": "benchmarks/calibration.py --constant consistent_eps0_t",
     "hybrid_closed_fraction": "benchmarks/calibration.py --constant hybrid_closed_fraction",
+    "edge_offset": "benchmarks/calibration.py --constant edge_offset",
     "augmented_eps0": "benchmarks/calibration.py --constant augmented_eps0",
     "condensed_cost": "benchmarks/scaling.py (condensed against factorised, side by side)",
     "blas_one_thread_dofs": "benchmarks/scaling.py (one and two BLAS threads, side by side)",

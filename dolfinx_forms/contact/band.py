@@ -54,7 +54,7 @@ def carry_state(new, old, u, lam, h):
     contact mesh size (how far a closed law point's state reaches)."""
     from scipy.spatial import cKDTree
 
-    new.halvings = old.halvings
+    new.halvings, new.alignments = old.halvings, old.alignments
     new.friction_origin = old.friction_origin
     new.set_load(lam)
     friction = new.mu > 0

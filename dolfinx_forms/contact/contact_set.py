@@ -115,6 +115,7 @@ class ContactSet(Multipliers):
         self.enforcement = enforcement
         self.relaxation = float(relaxation)
         self.halvings = 0  # Uzawa steps halved where the active set cycled (`newton.al_stall`)
+        self.alignments = 0  # multiplier node layouts aligned with the contact edges
         self.eps_n, self.eps_t, self.mu = float(eps_n), float(eps_t), float(mu)
         # the augmented loop's continuation in eps_t: each step's loop converges at eps_t_start
         # first, then at eps_t (`newton.augmented_loop`); self.eps_t is the one in use

@@ -6,6 +6,8 @@ step from the committed tractions; their vector layout for the loop, the admissi
 
 import numpy as np
 
+from dolfinx_forms import defaults
+
 
 class Multipliers:
     """Mixin of ContactSet: needs its pairs, committed, start_tractions, last, mu, eps_t,
@@ -81,3 +83,35 @@ class Multipliers:
         keys = ["law_tau_n"] + (["law_tau_t"] if self.mu > 0 else [])
         parts = [law(g, s, key) for key in keys for g, s in zip(self.pairs, self.last)]
         return np.concatenate(parts) if parts else np.zeros(0)
+
+    def align_edges(self):
+        """Lay each pair's P1 multiplier nodes out again where its contact zones' edges moved by
+        more than 0.1 node spacing from those the nodes are aligned with (`PairGeometry.
+        contact_zones`, `align_edges`: the first node outside an edge defaults.TUNING.
+        edge_offset elements past it). The zones are those of the last evaluation, its edges
+        where the shifted gap g_n + eps_n lambda_h changes sign. Returns whether any pair's
+        nodes changed (on this rank)."""
+        changed = False
+        for k, g in enumerate(self.pairs):
+            s = self.last[k]
+            if s is None or not g.law_at_points_with_nodes or g.layout[0] != "P1":
+                continue
+            length = g.layout[1]
+            zones = g.contact_zones(s["law_g_n"] + self.eps_n * self.lambda_n[k], 2.0 * length)
+            if not _moved(zones, g.zones or {}, 0.1 * length):
+                continue
+            g.align_edges(zones, defaults.TUNING.edge_offset)
+            changed = True
+        return changed
+
+
+def _moved(new, old, tol):
+    """Whether two {chain: [(sL, sR)]} zone sets differ (an edge by more than tol)."""
+    if new.keys() != old.keys() or any(len(new[q]) != len(old[q]) for q in new):
+        return True
+    for q in new:
+        for a, b in zip(new[q], old[q]):
+            for x, y in zip(a, b):
+                if (x is None) != (y is None) or (x is not None and abs(x - y) > tol):
+                    return True
+    return False

@@ -71,6 +71,9 @@ class NewtonOptions:
     # 19-22 Newton iterations at 1e-3 instead of 23-26 with the first leg converged to al_rtol
     # (18-21 without the continuation), the same answers
     al_switch: float = 1e-3
+    # the P1 multiplier nodes realigned with the contact zones' edges at most this often per
+    # loop (`ContactSet.align_edges`; 0: the nodes stay at equal spacing along Gamma_c)
+    al_align: int = 3
 
 
 @dataclass
@@ -238,7 +241,7 @@ def _augmented_loop(problem, lam, residuals, depth=20):
     x = cs.multipliers()
     u_good = problem.u.x.array.copy()  # the last converged solve and its tractions
     t_good = cs.tractions()
-    fallbacks = solves = 0
+    fallbacks = solves = aligned = 0
     best, stalled = np.inf, 0  # the smallest change yet, updates since
     for k in range(opts.max_augmentations + 1):
         t = cs.tractions()
@@ -263,6 +266,15 @@ def _augmented_loop(problem, lam, residuals, depth=20):
             X, F, best, stalled = [], [], np.inf, 0
         if switch or change <= min(opts.al_rtol * scale, gap_tol):
             if not switch and residuals[-1] <= tolerance(problem, residuals[0]):
+                # at the fixed point (so whatever eps0), the P1 nodes aligned with its contact
+                # edges, and the loop on to the new nodes' fixed point
+                if aligned < opts.al_align and comm.allreduce(cs.align_edges(), MPI.LOR):
+                    aligned += 1
+                    cs.alignments += 1
+                    problem.log(f"augmented Lagrangian: multiplier nodes aligned with the "
+                                f"contact edges ({aligned}), after {solves} solves")  # fmt: skip
+                    X, F, best, stalled = [], [], np.inf, 0
+                    continue
                 return True, solves, ""
             # after a switch an inexact solve; else the last solve, which stopped early
             early = opts.al_eta * change / max(scale, 1e-300) if switch else 0.0

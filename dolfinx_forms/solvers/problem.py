@@ -386,6 +386,8 @@ def solver_metrics(problem, converged=True):
         "multiplier_mass": problem.multiplier_mass if problem.contact.augmented else None,
         "augmentations": [int(s.augmentations) for s in problem.steps],
         "uzawa_halvings": int(problem.contact.halvings),  # `NewtonOptions.al_stall`
+        # multiplier nodes laid out again at the contact edges (`NewtonOptions.al_align`)
+        "edge_alignments": int(problem.contact.alignments),
         "cutbacks": int(sum(s.cutback for s in problem.steps)),
         "factorisations": int(problem.factorisations),
         "linear_solver": problem.linear.name,

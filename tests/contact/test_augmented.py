@@ -107,6 +107,9 @@ def test_hertz_independent_of_eps0(tmp_path, disc):
         pts = points(tmp_path / e)
         active = np.flatnonzero(pts["state"] != "open")
         assert np.all(pts["state"][active[0] : active[-1] + 1] != "open"), "checkerboard"
+    # the nodes were aligned with the contact edges (once here: the edges then stay within 0.1
+    # node spacing)
+    assert all(r["solver"]["edge_alignments"] >= 1 for r in runs)
     # the bulk is linear: the factorisation is reused while the active set stays
     s = runs[1]["solver"]
     assert sum(s["augmentations"]) > 0
