@@ -5,8 +5,8 @@ case it was tuned on and on a case it was not, side by side.
 The tuned case: Hertz (demos/hertz.py) at R = 10 mm, h = a/20, both paths. The check case:
 the same at R = 40 mm (a about twice as wide, h = a/20 of it: another mesh, another load per
 unit length of contact). Normal factors (pointwise_eps0, consistent_eps0, consistent_length,
-hybrid_closed_fraction, edge_offset): the augmented Lagrangian's p(x) L2 error against Hertz and against
-the circle. Tangential factors (pointwise_eps0_t, consistent_eps0_t): Cattaneo-Mindlin
+hybrid_closed_fraction, edge_offset): the augmented Lagrangian's p(x) L2 error against Hertz
+and against the circle. Tangential factors (pointwise_eps0_t, consistent_eps0_t): Cattaneo-Mindlin
 (--tangential 0.5 --mu 0.3), the stick half-width's relative error and q(x)'s L2 error.
 augmented_eps0: the Uzawa updates (its only effect: the answer does not depend on it).
 Runs in-process (demos/hertz.py's `solve`), one value at a time through
