@@ -22,8 +22,13 @@ class Multipliers:
 
     def start_step(self):
         """Multipliers of a new step (or a retried one): the committed tractions; eps_t its
-        loop's first."""
+        loop's first; the multiplier nodes equally spaced (`align_edges` aligns them with the
+        step's own contact edges, so that a step's answer does not depend on the steps
+        before: a band grown and the step done again gives the answer of the wider band)."""
         self.eps_t = self.eps_t_start
+        for g in self.pairs:  # equally spaced nodes again: a step's layout has no history
+            if g.zones:
+                g.align_edges({}, 0.0)
         for k in range(len(self.pairs)):
             tn, tt = self._committed_tractions(k)
             self.lambda_n[k], self.lambda_t[k] = tn.copy(), tt.copy()
