@@ -11,7 +11,7 @@ and with the augmented Lagrangian (P1 multipliers) alike (--enforcement, default
 The check. With h = a/k, k in --sizes, the relative L2 error of p(x) against Hertz decreases
 monotonically at a fitted rate (least squares, log error vs log h) >= 0.75; against the circle
 the scene meshes it is reported (Hertz's parabola is 0.4 % off it at R = 10, 0.03 % at R = 40),
-as are the rates of a and p0. Paths: body-fitted (gmsh, P1 triangles) and cut (Q1 on a graded
+as are the rates of a and p0. Paths: body-fitted (P1 triangles in layers) and cut (Q1 on a graded
 grid). --bulk resolved (default): bodies meshed so that their own error stays below the
 contact's (study.bulk_args); demo: hertz.py's meshes (at R = 40 their stiff far cells stall the
 augmented error near 0.4 %, which the penalty's compliance hides).
