@@ -348,8 +348,9 @@ VARIANTS = {  # name -> hertz.py arguments selecting the discretisation
 # near, an 80 a x 40 a block; at R = 40, a/80, body-fitted, a finer bulk moves the augmented
 # p(x) error by 0.004 %). With the demo's bulk the far cells make the bodies too stiff (a
 # narrower, higher pressure), which the penalty's compliance hides and the augmented
-# Lagrangian does not: at R = 40 the augmented error levels off at 0.41 % from a/80 on there
-# (0.26 % with the resolved bulk, falling at rate 0.96 from a/20; docs/demos/convergence_study.md)
+# Lagrangian does not: at R = 40, body-fitted, a/20 -> a/80, the augmented error falls from
+# 0.92 to 0.39 % there (rate 0.64), from 0.69 to 0.17 % with the resolved bulk (rate 1.08;
+# docs/demos/convergence_study.md)
 BULKS = ("resolved", "demo")
 PATHS, ENFORCEMENTS = ("conforming", "cut"), ("penalty", "augmented")
 # demos/convergence_study.py's variant of each path and enforcement: hertz.py's own meshes
