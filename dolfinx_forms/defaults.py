@@ -33,6 +33,9 @@ class Tuning:
     hybrid_closed_fraction: float = 0.75
     # the P1 multiplier nodes aligned with the contact zones (`NewtonOptions.al_align`): the
     # first node outside a contact edge lies this fraction of a multiplier element past it
+    # (Hertz a/20, p(x), body-fitted / cut: R = 10, 0 / 0.15 / 0.27 / 0.4 / 0.5: 1.21 / 1.12 /
+    # 1.07 / 1.09 / 1.19 % and 1.19 / 1.06 / 1.08 / 1.18 / 1.27 %; R = 40: 1.09 / 0.99 / 0.92 /
+    # 0.93 / 1.03 % and 1.12 / 0.98 / 0.98 / 1.06 / 1.13 %; the best at a/20, a/40, a/80 too)
     edge_offset: float = 0.27
     # the demos' --eps0 with --enforcement augmented (it sets the Uzawa step only)
     augmented_eps0: float = 1e-2
