@@ -88,16 +88,16 @@ def parse(argv):
     a.sizes = sorted(a.sizes)  # coarse to fine
     a.discretizations = list(PATHS) if a.discretization == "both" else [a.discretization]
     a.enforcements = list(ENFORCEMENTS) if a.enforcement == "both" else [a.enforcement]
-    a.groups = [(d, e) for d in a.discretizations for e in a.enforcements]
+    a.groups = {f"{d}-{e}": (d, e) for d in a.discretizations for e in a.enforcements}
     return a
 
 
 def sweep(args, a, scratch):
     """Every run, one process each, sequentially: h = a/k per group and size."""
     runs = []
-    for d, e in args.groups:
+    for group, (d, e) in args.groups.items():
         for k in args.sizes:
-            v, name, group = VARIANT[d, e], f"{d}-{e}-a{k}", f"{d}-{e}"
+            v, name = VARIANT[d, e], f"{group}-a{k}"
             print(f"[convergence] {group} ({v}) h = a/{k} ...", flush=True)
             rec = dict(discretization=d, enforcement=e, group=group, variant=v, h_divisor=k)
             extra = [*VARIANTS[v], *bulk_args(args.bulk, a, a / k, d == "cut")]
@@ -115,7 +115,7 @@ def main(argv=None):
     a, p0 = hertz_reference(dict(R=args.R))
     with tempfile.TemporaryDirectory(prefix="convergence_study.") as scratch:
         runs = sweep(args, a, scratch)
-        gs = [f"{d}-{e}" for d, e in args.groups]
+        gs = list(args.groups)
         groups = {g: [r for r in runs if r["group"] == g] for g in gs}
         summary = {g: study.convergence(groups[g], STUDY_ERRORS, *CHECK) for g in gs}
         data = dict(
@@ -123,13 +123,13 @@ def main(argv=None):
             case=dict(CASE, R=args.R), a_hertz=a, p0_hertz=p0, sizes=args.sizes,
             h=[a / k for k in args.sizes], discretizations=args.discretizations,
             enforcements=args.enforcements, groups=gs, bulk=args.bulk,
-            variants={f"{d}-{e}": VARIANT[d, e] for d, e in args.groups},
-            hertz_args={f"{d}-{e}": VARIANTS[VARIANT[d, e]] for d, e in args.groups},
+            variants={g: VARIANT[de] for g, de in args.groups.items()},
+            hertz_args={g: VARIANTS[VARIANT[de]] for g, de in args.groups.items()},
             **CONVERGENCE_DEFINITIONS,
             runs=[dict(r, files=f"runs/{r['name']}" if r["ok"] else None) for r in runs],
             summary=summary,
         )  # fmt: skip
-        panels = [(f"{g} ({VARIANT[dg]})", groups[g], summary[g]) for g, dg in zip(gs, args.groups)]
+        panels = [(f"{g} ({VARIANT[de]})", groups[g], summary[g]) for g, de in args.groups.items()]
         ks = ", ".join(map(str, args.sizes))
         title = (f"Hertz line contact, R = {args.R:g}: convergence in h (a = {a:.4g} mm, h = a/k, "
                  f"k = {ks}, bulk {args.bulk})")  # fmt: skip

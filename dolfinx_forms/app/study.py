@@ -411,9 +411,14 @@ def variant_path(variant):
     return "cut" if "cut" in VARIANTS[variant] else "conforming"
 
 
+def _case(case):
+    """CASE updated with `case` (a dict of some of its keys, or None)."""
+    return {**CASE, **(case or {})}
+
+
 def hertz_reference(case=None):
     """Hertz half-width and peak pressure of CASE (updated with `case`) at the requested load."""
-    c = {**CASE, **(case or {})}
+    c = _case(case)
     E_star = analytic.effective_modulus(c["E"], c["nu"], c["E"], c["nu"])
     a, p0 = analytic.hertz_line(c["load"], c["R"], E_star)
     return float(a), float(p0)
@@ -435,8 +440,7 @@ def run_hertz(script, h, variant_args=(), timeout=None, keep=None, case=None):
     folder that receives its metrics.json and tractions.csv."""
     script = Path(script).resolve()
     root = script.parents[1]
-    c = {**CASE, **(case or {})}
-    args = ["--h", repr(h), *(a for k, v in c.items() for a in (f"--{k}", repr(v)))]
+    args = ["--h", repr(h), *(a for k, v in _case(case).items() for a in (f"--{k}", repr(v)))]
     args = [*args, *variant_args]
     rec = run_demo(
         script.relative_to(root), args, cwd=root, evaluate=hertz_errors, timeout=timeout, keep=keep
