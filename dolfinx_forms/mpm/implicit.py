@@ -8,7 +8,8 @@ rigid level sets (`obstacles.py`). One load step:
    come from the current grid level sets (eqs 21-25), never from the initial shapes. The
    DOLFINx mesh is rebuilt only when a body's active cells or their kinds (or the pairs)
    change; forms and sparsity are made anew every step, because the cut weights and the
-   contact couplings move with the level sets;
+   contact couplings move with the level sets (their compiled kernels are kept in memory,
+   `fem.jit_memo`);
 2. the material points' stress is projected to the integration points of the new cells by MLS
    (eqs 38-45, `_cpp.MLSProjector`), per body, and enters the residual as the initial stress
    int sigma_0 : grad v;
@@ -46,6 +47,7 @@ from dolfinx_forms import _cpp
 from dolfinx_forms.common import worker_threads
 from dolfinx_forms.mpm import material_points as mp
 from dolfinx_forms.fem.boundary import Load
+from dolfinx_forms.fem import jit_memo
 from dolfinx_forms.fem.cut import grid_cells, material_window
 from dolfinx_forms.fem.laws import as_law, law_key
 from dolfinx_forms.mpm import evolution, records
@@ -124,6 +126,7 @@ class ImplicitMPM:
         log=print,
         **problem_kw,
     ):
+        jit_memo.install()  # new spaces and forms every step: FFCx's answers kept in memory
         self.comm = comm
         self.xlines, self.ylines = (np.asarray(v, float) for v in grid)
         self.grid = _cpp.StructuredGrid(self.xlines, self.ylines)

@@ -1,0 +1,72 @@
+"""The in-process memo over DOLFINx's JIT (fem/jit_memo.py): one compiled object per FFCx key,
+reused across meshes, and never shared by forms that differ (different constants, spaces,
+quadrature degrees). Also under mpirun -n 2: the memo sits under DOLFINx's collective wrapper."""
+
+import numpy as np
+import pytest
+import ufl
+from dolfinx import fem, jit, la, mesh as dmesh
+from mpi4py import MPI
+
+from dolfinx_forms.fem import jit_memo
+
+
+def _square(n, side):
+    return dmesh.create_rectangle(
+        MPI.COMM_WORLD, [[0.0, 0.0], [side, side]], [n, n], dmesh.CellType.quadrilateral
+    )
+
+
+def _total(form):
+    return MPI.COMM_WORLD.allreduce(fem.assemble_scalar(form), op=MPI.SUM)
+
+
+def test_one_compiled_object_per_key_and_the_right_values():
+    jit_memo.install()
+    jit_memo.install()  # idempotent: one memo layer
+    layer = jit.ffcx_jit.__wrapped__  # the memo, under DOLFINx's MPI wrapper
+    assert jit.ffcx_jit.memoised and hasattr(layer, "memo")
+    assert not hasattr(layer.__wrapped__, "memo")
+    memo = jit_memo._memo
+
+    # the same element on two meshes: one entry, the same compiled element
+    m1, m2 = _square(4, 1.0), _square(7, 2.0)
+    V1 = fem.FunctionSpace(m1, ("Lagrange", 1))
+    n = len(memo)
+    V2 = fem.FunctionSpace(m2, ("Lagrange", 1))
+    assert len(memo) == n and V2._ufcx_element is V1._ufcx_element
+    fem.FunctionSpace(m2, ("Lagrange", 2))
+    assert len(memo) == n + 1
+
+    # the same form on two meshes: one compiled form, each mesh's own integral
+    def area_form(m, c):
+        return fem.form(c * ufl.dx(domain=m))
+
+    n = len(memo)
+    assert np.isclose(_total(area_form(m1, 2.0)), 2.0)
+    assert np.isclose(_total(area_form(m2, 2.0)), 8.0)
+    assert len(memo) == n + 1
+    # a different constant (baked into the kernel) or quadrature degree: a new entry and value
+    assert np.isclose(_total(area_form(m2, 3.0)), 12.0)
+    assert len(memo) == n + 2
+    x = ufl.SpatialCoordinate(m2)
+    md = {"quadrature_degree": 1}
+    # int_0^2 int_0^2 x^4 dy dx = 2 * 32 / 5; degree 1 integrates x^4 inexactly
+    exact = fem.form(x[0] ** 4 * ufl.dx(domain=m2))
+    rough = fem.form(x[0] ** 4 * ufl.dx(domain=m2, metadata=md))
+    assert np.isclose(_total(exact), 64.0 / 5.0)
+    assert not np.isclose(_total(rough), 64.0 / 5.0, rtol=1e-3)
+
+    # a linear form with a coefficient, on the spaces of two meshes: each mesh's mass
+    for V, area in ((V1, 1.0), (V2, 4.0)):
+        ones, v = fem.Function(V), ufl.TestFunction(V)
+        ones.x.array[:] = 1.0
+        b = fem.assemble_vector(fem.form(ones * v * ufl.dx))
+        b.scatter_reverse(la.ScatterMode.add)
+        owned = b.array[: V.dofmap.index_map.size_local].sum()
+        assert np.isclose(MPI.COMM_WORLD.allreduce(owned, op=MPI.SUM), area)
+
+
+@pytest.mark.mpi
+def test_one_compiled_object_per_key_on_two_ranks():
+    test_one_compiled_object_per_key_and_the_right_values()
