@@ -97,8 +97,10 @@ def test_hertz_independent_of_eps0(tmp_path, disc):
         a, b = (r["results"][key] for r in runs)
         assert abs(a - b) <= 1e-5 * abs(a), key
     pen = [r["solver"]["penetration_h"] for r in runs]
-    # the same fixed point, whatever eps0
-    assert abs(pen[0]["points"] - pen[1]["points"]) <= 1e-5 * pen[0]["points"]
+    # the same fixed point, whatever eps0, to the loop's gap tolerance (al_gtol = 1e-6 h: the
+    # nodes are aligned once the gaps converged to it; the largest penetration between nodes,
+    # 6.8e-4 h, came out 7e-9 h apart at eps0 1e-4 and 1e4)
+    assert abs(pen[0]["points"] - pen[1]["points"]) <= 1e-6
     # the default hybrid projection: zero weighted gap on the nodes in contact, to the loop's
     # tolerance (issue 11: penetration below 1e-6 h; 3e-10 ... 6e-10 h seen)
     assert max(p["law_points"] for p in pen) < 1e-6
