@@ -123,16 +123,15 @@ def newton(problem, lam, r_ref=0.0, early=0.0):
         r = problem.residual(lam, with_tangent=not lazy, predictor=predictor, stick=stick)
         residuals.append(r)
         if not np.isfinite(r):
-            return (
-                False,
-                residuals,
-                (
-                    f"non-finite residual at iteration {it} (a singular system? every body needs "
-                    "its rigid motions held by Dirichlet conditions or by contact; a frictionless "
-                    "body can slide along the contact. Finite strain: det F <= 0 at an "
-                    "integration point, a step too large for the grid)"
-                ),
+            where = problem.nonfinite()
+            why = (
+                where
+                if where
+                else "a singular system? every body needs its rigid motions held by Dirichlet "
+                "conditions or by contact; a frictionless body can slide along the contact"
             )
+            return False, residuals, f"non-finite residual at iteration {it} ({why})"
+
         if r0 is None:
             r0 = max(r, r_ref)
         # relative to the step's first residual, with a round-off floor relative to the

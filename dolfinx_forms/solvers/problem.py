@@ -178,7 +178,6 @@ class ContactProblem:
         self.Ku = self.K.createVecLeft()
         self.f = self.K.createVecLeft()
 
-
     def destroy(self):
         """Free this problem's PETSc objects: petsc4py frees none when garbage-collected, so a
         run that makes a problem per step (the material-point path) calls this for each one it
@@ -262,6 +261,50 @@ class ContactProblem:
                 return self._zero_bc(zero_bc)
             self.control.measure(self.R)  # the reaction, from the rows zeroed next
             return float(np.hypot(self._zero_bc(zero_bc), self.control.residual(lam)))
+
+    def nonfinite(self):
+        """Where the last residual is not finite (Newton's failure message; collective): the
+        first of its parts (the iterate u, the loads f, the linear bulk K u, the nonlinear bulk,
+        the contact) with a non-finite entry, the body whose dofs hold it and a dof's position;
+        "" where every part is finite."""
+        n = self.n_owned
+        Ku = self.K.createVecLeft()
+        self.K.mult(self.u.vector, Ku)
+        parts = [
+            ("the displacement iterate (from the last linear solve: a singular system? every "
+             "body needs its rigid motions held by Dirichlet conditions or by contact)",
+             self.u.x.array[:n]),
+            ("the external loads (body forces, inertia)", self.f.array[:n]),
+            ("the linear bulk forces K u", Ku.array[:n]),
+            ("the nonlinear bulk forces (finite strain: det F <= 0 at an integration point?)",
+             self.bulk.b_nl.array[:n] if self.bulk.nonlinear else np.zeros(0)),
+            ("the contact forces", self._rc.x.array[:n]),
+        ]  # fmt: skip
+        first = None
+        for k, (_, values) in enumerate(parts):
+            bad = np.flatnonzero(~np.isfinite(values))
+            if len(bad):
+                first = (k, len(bad), bad[0])
+                break
+        linear.destroy(Ku)
+        where = (np.inf, 0, "", (np.nan, np.nan))  # part, count, body, a dof's position
+        if first is not None:
+            k, count, dof = first
+            bs = self.V.dofmap.index_map_bs
+            cells = np.flatnonzero((self.V.dofmap.list.array == dof // bs).reshape(
+                self.V.dofmap.list.num_nodes, -1).any(axis=1))  # fmt: skip
+            tags = self.scene.cell_tags
+            tag = tags.values[np.isin(tags.indices, cells)]
+            names = {b.tag: b.name for b in self.scene.bodies}
+            body = names.get(int(tag[0]), f"tag {int(tag[0])}") if len(tag) else "?"
+            x = self.V.tabulate_dof_coordinates()[dof // bs, :2]
+            where = (k, count, body, (float(x[0]), float(x[1])))
+        k, count, body, x = min(self.comm.allgather(where), key=lambda w: w[0])
+        if not np.isfinite(k):
+            return ""
+        total = self.comm.allreduce(count if where[0] == k else 0)
+        return (f"{parts[int(k)][0]}: not finite at {total} dof(s), on body {body!r} "
+                f"(one at x = ({x[0]:.6g}, {x[1]:.6g}))")  # fmt: skip
 
     def _zero_bc(self, zero_bc):
         if zero_bc:
