@@ -123,6 +123,16 @@ def newton(problem, lam, r_ref=0.0, early=0.0):
         r = problem.residual(lam, with_tangent=not lazy, predictor=predictor, stick=stick)
         residuals.append(r)
         if not np.isfinite(r):
+            # a step past what the state allows (finite strain: det F <= 0 beyond it) is
+            # halved like one that does not lower the residual, before the solve gives up
+            step = opts.line_search and r_base is not None and it < opts.max_iterations
+            if step and backtracks < opts.max_backtracks:
+                residuals.pop()
+                backtracks += 1
+                problem.u.x.array[:] -= 0.5**backtracks * problem.du.x.array
+                if problem.control is not None:
+                    problem.control.backtrack(0.5**backtracks)
+                continue
             where = problem.nonfinite()
             why = (
                 where

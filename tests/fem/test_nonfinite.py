@@ -1,6 +1,6 @@
 """A non-finite Newton residual is reported with where it is (`ContactProblem.nonfinite`): the
-part of the residual that first holds it, the body and a position, the same on every rank.
-Also under mpirun -n 2."""
+part of the residual that first holds it, the body and a position, the same on every rank; a
+Newton step into a non-finite residual is halved first. Also under mpirun -n 2."""
 
 import re
 
@@ -14,8 +14,8 @@ from dolfinx_forms.solvers.newton import newton
 from dolfinx_forms.solvers.problem import ContactProblem
 
 
-def _problem(law):
-    bcs = [Dirichlet("bottom", None, 0.0)]
+def _problem(law, push=0.0):
+    bcs = [Dirichlet("bottom", None, 0.0), Dirichlet("punch", 1, lambda lam: -lam * push)]
     return ContactProblem(block_scene(4), {1: law}, dirichlet=bcs, log=lambda *a: None)
 
 
@@ -53,6 +53,32 @@ def test_nonfinite_residual_says_where():
     p.destroy()
 
 
+def test_a_step_into_a_nonfinite_residual_is_halved():
+    """The residual after the first Newton step reads NaN once (as past a det F = 0): the step
+    is halved, Newton goes on from there and reaches the solution of the undisturbed solve."""
+    ref = _problem(LinearElastic(E, NU), push=0.01)
+    ok, res_ref, _ = newton(ref, 1.0)
+    assert ok
+    p = _problem(LinearElastic(E, NU), push=0.01)
+    residual, calls = p.residual, []
+
+    def once_nan(lam, **kw):
+        r = residual(lam, **kw)
+        calls.append(r)
+        return np.nan if len(calls) == 2 else r
+
+    p.residual = once_nan
+    ok, res, why = newton(p, 1.0)
+    assert ok, why
+    assert np.all(np.isfinite(res)) and len(res) == len(res_ref) + 1  # the halved step's
+    assert np.isclose(res[1], 0.5 * res[0], rtol=1e-6)  # linear: half the step, half of R
+    scale = np.abs(ref.u.x.array).max()
+    assert np.allclose(p.u.x.array, ref.u.x.array, rtol=0, atol=1e-10 * scale)
+    for q in (p, ref):
+        q.destroy()
+
+
 @pytest.mark.mpi
 def test_nonfinite_residual_says_where_on_two_ranks():
     test_nonfinite_residual_says_where()
+    test_a_step_into_a_nonfinite_residual_is_halved()
