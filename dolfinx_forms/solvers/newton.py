@@ -129,9 +129,7 @@ def newton(problem, lam, r_ref=0.0, early=0.0):
             if step and backtracks < opts.max_backtracks:
                 residuals.pop()
                 backtracks += 1
-                problem.u.x.array[:] -= 0.5**backtracks * problem.du.x.array
-                if problem.control is not None:
-                    problem.control.backtrack(0.5**backtracks)
+                _backtrack(problem, 0.5**backtracks)
                 continue
             where = problem.nonfinite()
             why = (
@@ -172,9 +170,7 @@ def newton(problem, lam, r_ref=0.0, early=0.0):
         if worse or (cycling and opts.damp_cycles and r_base is not None):
             if backtracks < opts.max_backtracks and it < opts.max_iterations:
                 backtracks += 1
-                problem.u.x.array[:] -= 0.5**backtracks * problem.du.x.array
-                if problem.control is not None:
-                    problem.control.backtrack(0.5**backtracks)
+                _backtrack(problem, 0.5**backtracks)
                 continue
         if cycling:
             return False, residuals, f"active set cycles (iteration {it})"
@@ -207,6 +203,13 @@ def newton(problem, lam, r_ref=0.0, early=0.0):
         problem.du.x.scatter_forward()
         problem.u.x.array[:] += problem.du.x.array
     return False, residuals, f"no convergence in {opts.max_iterations} iterations"
+
+
+def _backtrack(problem, fraction):
+    """Take `fraction` of the last Newton step back (u and the force control's load)."""
+    problem.u.x.array[:] -= fraction * problem.du.x.array
+    if problem.control is not None:
+        problem.control.backtrack(fraction)
 
 
 def _keep(problem, key, lazy, lam):
