@@ -109,7 +109,8 @@ def main(argv=None):
         # the problem: Coulomb friction at the friction angle, on grains and plates alike
         mpm_bodies = [MPMBody(n, t, (args.E, args.nu), s) for n, t, s in bodies]
         mu = np.tan(np.radians(args.friction_angle))
-        kw = dict(obstacles=list(plates.values()), mu=mu, predictor_gap=0.5 * args.h)
+        # the predictor holds the grains where they touch (they start 0.02 h overlapped)
+        kw = dict(obstacles=list(plates.values()), mu=mu, predictor_gap=0.05 * args.h)
         sim = ImplicitMPM(  # problem_options: eps0, --petsc, --linear-solver
             run.comm, grid, mpm_bodies, scene, **kw, timer=run.timer, **run.problem_options
         )

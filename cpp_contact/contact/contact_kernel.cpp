@@ -193,6 +193,7 @@ ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPena
   s.law_tau_n.resize(na);
   s.law_tau_t.resize(na);
   s.law_state.resize(na);
+  s.law_coupled.assign(na, 0);
   if (friction)
     s.gtp_trial.resize(na);
 
@@ -324,6 +325,7 @@ ContactPointState assemble_contact(const ContactQuadrature& q, const CoulombPena
       }
     }
     insert(sdofs, Ke);
+    s.law_coupled[a] = 1;
   }
   return s;
 }

@@ -69,6 +69,7 @@ struct ContactPointState {
   std::vector<double> law_tau_n, law_tau_t; ///< law points' tractions (compression negative)
   std::vector<ContactState> law_state;      ///< law points' state: open / stick / slip
   std::vector<double> gtp_trial;            ///< law points' plastic slip after this evaluation
+  std::vector<std::int8_t> law_coupled;     ///< 1 where a law point's tangent block was inserted
 };
 
 /// @brief Callback receiving one point's element matrix: block dofs (nodes_i + nodes_j) and the

@@ -37,6 +37,25 @@ void check_dofs(const char* function, const contact::ContactQuadrature& q, std::
   check_range(Arg{function, j.c_str()}, q.dofs_j, 0, blocks);
 }
 
+/// @brief The law points whose coupling blocks to insert: `points` (indices into the law
+/// points, checked), or every one of c's blocks for None.
+std::vector<std::size_t> selected(const Arg& arg, const py::object& points,
+                                  const contact::CouplingBlocks& c) {
+  const std::size_t n = c.offsets.size() - 1;
+  std::vector<std::size_t> out;
+  if (points.is_none()) {
+    out.resize(n);
+    for (std::size_t s = 0; s < n; ++s)
+      out[s] = s;
+    return out;
+  }
+  const Indices idx(arg, points, {any});
+  idx.check_range(0, std::int64_t(n));
+  for (std::int32_t s : idx.flat())
+    out.push_back(std::size_t(s));
+  return out;
+}
+
 } // namespace
 
 void bind_assembly(py::module_& m) {
@@ -143,29 +162,30 @@ void bind_assembly(py::module_& m) {
 
   m.def(
       "insert_coupling",
-      [](dolfinx::la::SparsityPattern& pattern, const ContactQuadrature& q) {
+      [](dolfinx::la::SparsityPattern& pattern, const ContactQuadrature& q,
+         const py::object& points) {
         check_dofs("insert_coupling", q, pattern_blocks(pattern), "the pattern's index map");
         const contact::CouplingBlocks c = contact::coupling_dofs(q);
-        for (std::size_t s = 0; s + 1 < c.offsets.size(); ++s) {
+        for (std::size_t s : selected(Arg{"insert_coupling", "points"}, points, c)) {
           std::span<const std::int32_t> d(c.dofs.data() + c.offsets[s],
                                           c.offsets[s + 1] - c.offsets[s]);
           pattern.insert(d, d);
         }
       },
-      py::arg("pattern"), py::arg("quadrature"),
-      "Add the contact coupling blocks of every law point to a (not yet assembled) "
-      "SparsityPattern");
+      py::arg("pattern"), py::arg("quadrature"), py::arg("points") = py::none(),
+      "Add the contact coupling blocks of the law points `points` (indices; None: every law "
+      "point) to a (not yet assembled) SparsityPattern");
 
   m.def(
       "add_coupling_zeros",
-      [](Mat A, const ContactQuadrature& q) {
+      [](Mat A, const ContactQuadrature& q, const py::object& points) {
         // PETSc squeezes preallocated but unused entries out at the first final assembly:
         // explicit zeros keep the contact blocks in the matrix for every later iteration.
         const PetscInt blocks = contact::python::local_block_rows(A);
         if (blocks >= 0)
           check_dofs("add_coupling_zeros", q, blocks, "A's local-to-global map");
         const contact::CouplingBlocks c = contact::coupling_dofs(q);
-        for (std::size_t s = 0; s + 1 < c.offsets.size(); ++s) {
+        for (std::size_t s : selected(Arg{"add_coupling_zeros", "points"}, points, c)) {
           const auto nd = PetscInt(c.offsets[s + 1] - c.offsets[s]);
           const std::vector<double> zeros(std::size_t(4 * nd * nd), 0.0);
           petsc_check(MatSetValuesBlockedLocal(A, nd, c.dofs.data() + c.offsets[s], nd,
@@ -174,8 +194,9 @@ void bind_assembly(py::module_& m) {
                       "MatSetValuesBlockedLocal (coupling block outside the sparsity pattern)");
         }
       },
-      py::arg("A"), py::arg("quadrature"),
-      "Add explicit zeros on the contact coupling blocks (before the matrix's first assembly)");
+      py::arg("A"), py::arg("quadrature"), py::arg("points") = py::none(),
+      "Add explicit zeros on the contact coupling blocks of the law points `points` (indices; "
+      "None: every law point), before the matrix's first assembly");
 
   m.def(
       "assemble_contact",
@@ -236,6 +257,7 @@ void bind_assembly(py::module_& m) {
         d["tau_n"] = to_numpy(std::move(s.tau_n), {nq});
         d["tau_t"] = to_numpy(std::move(s.tau_t), {nq});
         d["state"] = to_numpy(std::move(st), {nq});
+        d["law_coupled"] = to_numpy(std::move(s.law_coupled), {na});
         if (mu > 0)
           d["gtp_trial"] = to_numpy(std::move(s.gtp_trial), {na});
         else
@@ -249,7 +271,8 @@ void bind_assembly(py::module_& m) {
       "Contact residual (added into the local array b) and tangent (added into the PETSc Mat A "
       "by local block indices; call A.assemble() after) of eq 48. Returns a dict of per-point "
       "g_n, g_t, tau_n, tau_t, state (int8 ContactState), of law points (multiplier nodes, or "
-      "the points) law_g_n, law_g_t, law_tau_n, law_tau_t, law_state, and their gtp_trial "
+      "the points) law_g_n, law_g_t, law_tau_n, law_tau_t, law_state, law_coupled (int8: 1 "
+      "where the law point's tangent block went into A), and their gtp_trial "
       "(None when mu == 0). gtp_old and g_n_shift (eps_n lambda_n of the augmented "
       "Lagrangian, added to the gap the law sees, or None) are per law point. Arrays are "
       "float64, C-contiguous (b also writeable, never copied); every block dof must index u "

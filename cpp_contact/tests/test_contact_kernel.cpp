@@ -93,3 +93,34 @@ TEST(ContactKernel, RejectsInconsistentQuadrature) {
   EXPECT_THROW(assemble_contact(q, CoulombPenalty{1e-2, 1e-2, 0.0}, u, {}, {}, {}),
                std::invalid_argument);
 }
+
+// law_coupled says which law points inserted a tangent block (the sparsity that holds the
+// contact tangent is grown from it): the closed ones, the predictor's touching open ones too,
+// none without an inserter.
+TEST(ContactKernel, CoupledFlagsTheInsertedBlocks) {
+  std::mt19937 gen(3);
+  const ContactQuadrature q = make(gen, 40);
+  std::vector<double> u(8, 0.0), gtp(q.size(), 0.0);
+  const CoulombPenalty law{1e-2, 1e-2, 0.3};
+  for (double closed_gap : {0.0, 0.005}) {
+    int calls = 0;
+    BlockInserter ins = [&calls](std::span<const std::int32_t>, std::span<const double>) {
+      ++calls;
+    };
+    const ContactPointState s =
+        assemble_contact(q, law, u, gtp, {}, ins, TangentMode::exact, 1e-9, closed_gap);
+    int coupled = 0, open = 0;
+    for (std::size_t a = 0; a < q.size(); ++a) {
+      const bool closed = s.law_state[a] != ContactState::open;
+      open += !closed;
+      EXPECT_EQ(s.law_coupled[a], closed or s.law_g_n[a] < closed_gap ? 1 : 0) << a;
+      coupled += s.law_coupled[a];
+    }
+    EXPECT_EQ(calls, coupled);
+    EXPECT_GT(open, 0);
+    EXPECT_GT(coupled, 0);
+  }
+  const ContactPointState none = assemble_contact(q, law, u, gtp, {}, BlockInserter{});
+  for (std::int8_t c : none.law_coupled)
+    EXPECT_EQ(c, 0);
+}

@@ -224,6 +224,7 @@ class Steps:
             condensed_dofs=int(getattr(sim.problem.linear, "num_dofs", 0)),
             cutbacks=int(sum(r["cutbacks"] for r in self.records)),
             factorisations=[r["factorisations"] for r in self.records],  # per step
+            coupling_rebuilds=[r["coupling_rebuilds"] for r in self.records],  # per step
             warnings=[f"step {k}: {w}" for w, k in self.checks.items()],
         )
 

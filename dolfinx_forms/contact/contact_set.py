@@ -157,13 +157,33 @@ class ContactSet(Multipliers):
     def __len__(self):
         return len(self.pairs)
 
-    def insert_couplings(self, pattern):
-        for g in self.pairs:
-            _cpp.insert_coupling(pattern, g.quadrature)
+    def insert_couplings(self, pattern, points=None):
+        """The pairs' tangent blocks into a sparsity pattern: of the law points `points`
+        (indices per pair), or of every law point (None)."""
+        for k, g in enumerate(self.pairs):
+            _cpp.insert_coupling(pattern, g.quadrature, None if points is None else points[k])
 
-    def add_zeros(self, A):
-        for g in self.pairs:
-            _cpp.add_coupling_zeros(A, g.quadrature)
+    def add_zeros(self, A, points=None):
+        for k, g in enumerate(self.pairs):
+            _cpp.add_coupling_zeros(A, g.quadrature, None if points is None else points[k])
+
+    def law_gaps0(self, k):
+        """Pair k's gap per law point before the step's deformation: the smallest of its
+        points' (up to the weighted mean), the point's lesser of g_n0 and g_n0 + u_j.n after an
+        obstacle's whole step motion (eq 26 with u_i = 0)."""
+        g = self.pairs[k]
+        gap = np.asarray(g.g_n0, float)
+        if g.obstacle is not None:
+            u_j = g.obstacle.step_displacement(g.p_j, 1.0)
+            gap = np.minimum(gap, gap + np.einsum("pi,pi->p", u_j, g.normals))
+        if not g.law_at_nodes:  # the law at the points
+            return gap
+        out = np.full(g.num_law_points, np.inf)
+        nodes = np.asarray(g.mult_nodes)
+        gaps = np.broadcast_to(gap[:, None], nodes.shape)
+        on = nodes >= 0
+        np.minimum.at(out, nodes[on], gaps[on])
+        return out
 
     def names(self, scene):
         """(body i, body j or obstacle) names of each pair: the key of a pair across scenes."""

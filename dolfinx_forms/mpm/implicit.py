@@ -347,6 +347,7 @@ class ImplicitMPM:
             cutbacks=int(sum(s.cutback for s in problem.steps)),
             # sparse factorisations of the accepted solve (each step builds its own problem)
             factorisations=int(problem.factorisations),
+            coupling_rebuilds=int(problem.coupling_rebuilds),  # SolverOptions.coupling_gap
             num_dofs=int(imap.size_global * problem.bs),
             num_cells=int(scene.mesh.topology.index_map(2).size_global),
             points_outside_cells=outside,

@@ -127,6 +127,7 @@ class Factorised:
 
     def __init__(self, problem, petsc_options=None, symmetric=False):
         self.problem, self.symmetric = problem, bool(symmetric)
+        self.petsc_options = petsc_options
         self.ksp = PETSc.KSP().create(problem.comm)
         self.ksp.setOptionsPrefix("ils_")
         opts = PETSc.Options()
@@ -158,6 +159,10 @@ class Factorised:
         if self.symmetric:
             self.J = J  # the lifting's columns
         self.ksp.setOperators(self.A if self.symmetric else J)
+
+    def renewed(self, problem):
+        """A solver like this one (options, LDL^T or LU as it is now) for problem's new J."""
+        return Factorised(problem, self.petsc_options, self.symmetric)
 
     def solve(self, b, x):
         rhs, lifted = self.dirichlet.rhs(self.J, b) if self.symmetric else (b, False)
@@ -486,19 +491,48 @@ def choose(problem, kind="auto", petsc_options=None):
     default solver options (or for options naming pc_type=gamg); else Condensed for a linear
     bulk on one process with the default direct solver and a contact block of m dofs well
     below the n dofs, m^3 <= defaults.TUNING.condensed_cost n^1.5; Factorised otherwise."""
-    if kind not in KINDS:
-        raise ValueError(f"linear_solver: {', '.join(map(repr, KINDS))}, not {kind!r}")
+    picked, dofs = _pick(problem, kind, petsc_options)
+    if picked == "iterative":
+        return Iterative(problem, _without_direct(petsc_options) if kind == "iterative" else (
+            petsc_options if (petsc_options or {}).get("pc_type") == "gamg" else None))  # fmt: skip
+    if picked == "condensed":
+        return Condensed(problem, dofs, petsc_options)
     default = not petsc_options or {**DEFAULT_OPTIONS, **petsc_options} == DEFAULT_OPTIONS
     symmetric = default and problem.mu == 0  # Factorised's LDL^T, LU once J is not symmetric
-    if kind == "factorised":
-        return Factorised(problem, petsc_options, symmetric)
-    if kind == "iterative":
-        return Iterative(problem, _without_direct(petsc_options))
-    if kind == "auto" and (petsc_options or {}).get("pc_type") == "gamg":
-        return Iterative(problem, petsc_options)
+    return Factorised(problem, petsc_options, symmetric)
+
+
+def picks(problem, kind="auto", petsc_options=None):
+    """The solver `choose` builds for these options: "factorised", "condensed" or
+    "iterative" (ValueError where "condensed" does not apply). Only a factorisation of the
+    whole J pays for the explicit zeros of its sparsity (`ContactProblem.coupled`)."""
+    return _pick(problem, kind, petsc_options)[0]
+
+
+def _pick(problem, kind, petsc_options):
+    if kind not in KINDS:
+        raise ValueError(f"linear_solver: {', '.join(map(repr, KINDS))}, not {kind!r}")
+    if kind in ("factorised", "iterative"):
+        return kind, None
+    default = not petsc_options or {**DEFAULT_OPTIONS, **petsc_options} == DEFAULT_OPTIONS
     body_fitted = getattr(problem.scene, "cut", None) is None
-    if kind == "auto" and default and body_fitted and problem.num_dofs >= ITERATIVE_MIN_DOFS:
-        return Iterative(problem)
+    if kind == "auto" and (
+        (petsc_options or {}).get("pc_type") == "gamg"
+        or (default and body_fitted and problem.num_dofs >= ITERATIVE_MIN_DOFS)
+    ):
+        return "iterative", None
+    why, dofs = _not_condensed(problem, kind, petsc_options)
+    if why is None:
+        return "condensed", dofs
+    if kind == "condensed":
+        raise ValueError(f"linear_solver: 'condensed' does not apply here: {why}")
+    return "factorised", None
+
+
+def _not_condensed(problem, kind, petsc_options):
+    """(why Condensed does not apply, or does not pay under "auto"; None where it does, the
+    contact dofs)."""
+    default = not petsc_options or {**DEFAULT_OPTIONS, **petsc_options} == DEFAULT_OPTIONS
     why = None
     if problem.comm.size > 1:
         why = "MUMPS Schur complements are serial"
@@ -513,11 +547,7 @@ def choose(problem, kind="auto", petsc_options=None):
     costly = float(m) ** 3 > defaults.TUNING.condensed_cost * float(n) ** 1.5
     if why is None and kind == "auto" and costly:
         why = f"{m} contact dofs of {n}: a dense update would cost more than a factorisation"
-    if why is None:
-        return Condensed(problem, dofs, petsc_options)
-    if kind == "condensed":
-        raise ValueError(f"linear_solver: 'condensed' does not apply here: {why}")
-    return Factorised(problem, petsc_options, symmetric)
+    return why, dofs
 
 
 def _without_direct(petsc_options):

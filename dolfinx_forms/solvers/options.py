@@ -73,11 +73,20 @@ class SolverOptions:
     options of the linear solves. linear_solver: "auto", "condensed", "factorised" or
     "iterative" (`solvers.linear`: a linear bulk on one process is factorised once and Newton
     runs on the Schur complement of the contact dofs; "iterative": CG + GAMG with the
-    rigid-body modes, chosen by "auto" for large body-fitted problems)."""
+    rigid-body modes, chosen by "auto" for large body-fitted problems). coupling_gap (in
+    units of h; with `Factorised` only): the sparsity holds the contact tangent blocks of the
+    law points whose gap before the step's deformation is below it (or below predictor_gap,
+    whose first tangent holds touching points), not those of every law point of the band: most
+    of those stay open, and their explicit zeros cost MUMPS (100 grains: 20.9k of 22.7k law
+    points open, a numeric factorisation 0.27 s with them against 0.14 s with J's nonzeros
+    alone). A point outside that closes adds itself, and every point then nearer than it, to
+    the sparsity, and the matrices are built again (`ContactProblem.residual`; counted in
+    `coupling_rebuilds`). None: every law point of the band."""
 
     newton: object = None
     petsc_options: dict | None = None
     linear_solver: str = "auto"
+    coupling_gap: float | None = 0.05
 
 
 GROUPS = {"contact": ContactOptions, "fem": FemOptions, "solver": SolverOptions}

@@ -98,6 +98,15 @@ class ContactProblem:
                 self.V, scene, band=self.band, obstacles=obstacles, **settings
             )
         self.pairs = self.contact.pairs
+        # the law points whose tangent blocks the sparsity holds (`SolverOptions.coupling_gap`)
+        if so.coupling_gap is not None and not so.coupling_gap >= 0:
+            raise ValueError(
+                f"coupling_gap: a number >= 0 (units of h) or None, not {so.coupling_gap}"
+            )
+        self.coupling_gap = None if so.coupling_gap is None else float(so.coupling_gap) * h
+        self.coupling_rebuilds = 0  # matrices built again for a point outside the sparsity
+        self._coupled = linear.picks(self, so.linear_solver, so.petsc_options) == "factorised"
+        self.coupled = self._coupling_points()
         with self.phase("assembly"):
             self._matrices(fo.ghost_penalty)
         self.retired = [0, 0]  # factorisations of the linear solvers a band growth replaced
@@ -149,15 +158,71 @@ class ContactProblem:
         self.bc_owned = all_bc[all_bc < self.n_owned].astype(np.int32)
         self.bc_global = (self.bc_owned + imap.local_range[0] * self.bs).astype(np.int32)
 
+    def _coupling_points(self, gap=None):
+        """Per pair, the law points whose tangent blocks the sparsity holds: those with a gap
+        below `gap` before the step's deformation (`ContactSet.law_gaps0`; default the larger of
+        coupling_gap and predictor_gap); None (every law point) without a coupling_gap or where
+        the linear solver is not `Factorised`."""
+        if self.coupling_gap is None or not self._coupled:
+            return None
+        # the predictor's first tangent holds the touching points too
+        gap = max(self.coupling_gap, self.predictor_gap) if gap is None else gap
+        return [np.flatnonzero(self.contact.law_gaps0(k) < gap) for k in range(len(self.pairs))]
+
+    def _outside_coupling(self):
+        """After a contact assembly into J: per pair, the law points that put a tangent block
+        into J but are not in its sparsity (J dropped those entries), or None if there are none
+        on any rank."""
+        if self.coupled is None:
+            return None
+        out = [
+            np.setdiff1d(np.flatnonzero(s["law_coupled"]), c, assume_unique=True)
+            for s, c in zip(self.contact.last, self.coupled)
+        ]
+        return out if self.comm.allreduce(any(len(o) for o in out), op=MPI.LOR) else None
+
+    def _grow_coupling(self, outside):
+        """The sparsity grown by the points `outside` and by every law point whose current gap
+        is below the largest of theirs (or coupling_gap); matrices and solver built again."""
+        gaps = [s["law_g_n"] for s in self.contact.last]
+        reach = max(
+            [self.coupling_gap] + [float(np.max(g[o])) for g, o in zip(gaps, outside) if len(o)]
+        )
+        reach = self.comm.allreduce(reach, op=MPI.MAX)
+        self.coupled = [
+            np.union1d(np.union1d(c, o), np.flatnonzero(g <= reach)).astype(np.int32)
+            for c, o, g in zip(self.coupled, outside, gaps)
+        ]
+        self.coupling_rebuilds += 1
+        self._rebuild_linear(renew=True)
+
+    def _rebuild_linear(self, renew=False):
+        """Matrices and linear solver built again (a wider band; a grown sparsity, renew: a
+        solver like the one in use, `Factorised.renewed`); the factorisations so far are kept
+        in the count."""
+        self.retired[0] = self.factorisations
+        self.retired[1] = self.schur_factorisations
+        old = self.linear
+        old.destroy()
+        linear.destroy(self.K, self.J, self.R, self.Ku, self.f)
+        with self.phase("assembly"):
+            self._matrices(self._rebuild["fem"].ghost_penalty)
+        so = self._rebuild["solver"]
+        with self.phase("solve"):
+            if renew:
+                self.linear = old.renewed(self)
+            else:
+                self.linear = linear.choose(self, so.linear_solver, so.petsc_options)
+
     def _matrices(self, ghost_penalty):
-        """Sparsity: mesh couplings + contact coupling blocks (+ ghost-penalty cell pairs); the
-        pattern never changes. K (the linear bulk), J (the tangent), R, Ku, f."""
+        """Sparsity: mesh couplings + contact coupling blocks of the law points `coupled` (+
+        ghost-penalty cell pairs). K (the linear bulk), J (the tangent), R, Ku, f."""
         pattern = _dcpp.fem.create_sparsity_pattern(
             self.mesh.topology,
             [self.V.dofmap._cpp_object, self.V.dofmap._cpp_object],
             {_dcpp.fem.IntegralType.cell},
         )
-        self.contact.insert_couplings(pattern)
+        self.contact.insert_couplings(pattern, self.coupled)
         if self.integration is not None and ghost_penalty > 0:
             self.integration.insert_ghost_couplings(pattern, self.V)
         pattern.assemble()
@@ -166,11 +231,14 @@ class ContactProblem:
         self.bulk.assemble_linear(self.K)
         self.K.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)  # assemble_matrix ends in INSERT
         self.K.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
-        self.contact.add_zeros(self.K)
+        self.contact.add_zeros(self.K, self.coupled)
         self.K.assemble()
         self.J = self.K.duplicate(copy=False)
         self.J_key = None  # newton._keep: the key of the tangent J holds (None: none)
-        self.J.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
+        if self.coupled is None:
+            self.J.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
+        else:  # a block outside the sparsity is dropped, then found (`_outside_coupling`)
+            self.J.setOption(PETSc.Mat.Option.NEW_NONZERO_LOCATIONS, False)
         # zeroRows must not shrink the pattern: MatCopy(SAME_NONZERO_PATTERN) each iteration
         # and the reuse of the symbolic LU factorisation depend on it
         self.J.setOption(PETSc.Mat.Option.KEEP_NONZERO_PATTERN, True)
@@ -245,6 +313,11 @@ class ContactProblem:
                 self.predictor_gap if predictor else 0.0,
                 stick,
             )
+        outside = self._outside_coupling() if with_tangent else None
+        if outside is not None:  # J dropped their blocks: a wider sparsity, then again
+            self._grow_coupling(outside)
+            return self.residual(lam, with_tangent, zero_bc, predictor, stick)
+        with self.phase("contact"):
             self._rc.x.scatter_reverse(la.ScatterMode.add)
         with self.phase("assembly"):
             self.R.array[:] += self._rc.x.array[: self.n_owned]
@@ -374,15 +447,8 @@ class ContactProblem:
         if failed:
             raise ContactSolverError(f"contact band {band:.4g}: rebuilding Gamma_c: {failed}")
         self.contact, self.pairs, self.band = new, new.pairs, band
-        self.retired[0] = self.factorisations
-        self.retired[1] = self.schur_factorisations
-        self.linear.destroy()
-        linear.destroy(self.K, self.J, self.R, self.Ku, self.f)
-        with self.phase("assembly"):
-            self._matrices(self._rebuild["fem"].ghost_penalty)
-        so = self._rebuild["solver"]
-        with self.phase("solve"):
-            self.linear = linear.choose(self, so.linear_solver, so.petsc_options)
+        self.coupled = self._coupling_points()
+        self._rebuild_linear()
         self.log(
             f"contact band doubled to {band:.4g}: active points reached 0.9 of "
             f"{band / 2:.4g} at load level {lam:.4g}; the step is done again"
@@ -433,6 +499,8 @@ def solver_metrics(problem, converged=True):
         "edge_alignments": int(problem.contact.alignments),
         "cutbacks": int(sum(s.cutback for s in problem.steps)),
         "factorisations": int(problem.factorisations),
+        # the sparsity grown for a closing point outside it (`SolverOptions.coupling_gap`)
+        "coupling_rebuilds": int(problem.coupling_rebuilds),
         "linear_solver": problem.linear.name,
         "schur_factorisations": int(problem.schur_factorisations),
         # the contact band at the start and at the end (`ContactProblem.grow_band`)

@@ -33,22 +33,22 @@ def scene(kind):
     return hertz_scene(MPI.COMM_WORLD, **size)
 
 
-def hertz_problem(sc, linear_solver, materials=None):
+def hertz_problem(sc, linear_solver, materials=None, **extra):
     top_x, top_y = Dirichlet("cylinder_top", 0, 0.0), Dirichlet("cylinder_top", 1, 0.0)
     pb = ContactProblem(
         sc,
         materials or {b.tag: (E, NU) for b in sc.bodies},
         dirichlet=[Dirichlet("block_bottom", None, 0.0), top_x, top_y],
         log=lambda *a, **k: None,
-        **options(eps0=0.5, band=1.6**2 / (2 * R), linear_solver=linear_solver),
+        **options(eps0=0.5, band=1.6**2 / (2 * R), linear_solver=linear_solver, **extra),
     )
     return pb, top_x, top_y
 
 
-def mindlin(sc, linear_solver, materials=None, before=None):
+def mindlin(sc, linear_solver, materials=None, before=None, **extra):
     """Normal force P (frictionless), friction on, tangential force Q = 0.5 mu P; returns the
     problem and the reactions reached by the two force stages (each right after its stage)."""
-    pb, top_x, top_y = hertz_problem(sc, linear_solver, materials)
+    pb, top_x, top_y = hertz_problem(sc, linear_solver, materials, **extra)
     if before is not None:
         before(pb)
     protocol.reach_force(pb, top_y, "block_bottom", 1, P, first_guess=-0.05)
