@@ -95,6 +95,12 @@ def _guard_jacobian(F, targets, x, F_points):
     return len(bad)
 
 
+def _ratio_range(points):
+    """[min, max] of the points' vol / vol0 (det F)."""
+    r = points.vol / points.vol0
+    return [float(r.min()), float(r.max())] if len(r) else [1.0, 1.0]
+
+
 def _stress_tensor(s):
     return ufl.as_matrix([[s[0], s[2]], [s[2], s[1]]])
 
@@ -356,6 +362,8 @@ class ImplicitMPM:
             mls_F_nearest=mls_info.get("F_nearest", 0),
             mass={b.name: float(self.points[b.tag].vol0.sum()) for b in self.bodies},
             volume_points={b.name: float(self.points[b.tag].vol.sum()) for b in self.bodies},
+            # the smallest and largest vol / vol0 = det F of each body's points
+            point_volume_ratio={b.name: _ratio_range(self.points[b.tag]) for b in self.bodies},
             wall_s=time.perf_counter() - t0,
             **evo,
         )

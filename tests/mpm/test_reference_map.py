@@ -84,6 +84,27 @@ def test_a_drifted_level_set_is_reported():
     assert len(warnings) == 2 and warnings[0].startswith("b: ") and warnings[1].startswith("c: ")
 
 
+def test_a_spread_of_point_volumes_is_reported():
+    """mpm_run.point_volume_warnings: a body whose points' det F (vol / vol0, the record's
+    `point_volume_ratio` from the points) differ by more than a factor 2 is named, with the same
+    text at every step; a body compressed uniformly by 40 % is not."""
+    from dolfinx_forms.app.mpm_run import point_volume_warnings
+    from dolfinx_forms.mpm.implicit import _ratio_range
+
+    pts = disc_points()
+    pts.vol = 0.6 * pts.vol0
+    uniform = _ratio_range(pts)
+    assert uniform == pytest.approx([0.6, 0.6], rel=1e-12)
+    pts.vol[:2] = pts.vol0[:2] * np.array([0.005, 2.3])  # the column's grain near its wall
+    broken = _ratio_range(pts)
+    assert broken == pytest.approx([0.005, 2.3], rel=1e-12)
+    rec = dict(point_volume_ratio={"a": uniform, "b": broken, "c": [0.5, 0.99]})
+    warnings = point_volume_warnings(rec)
+    assert len(warnings) == 1 and warnings[0].startswith("b: ")
+    rec["point_volume_ratio"]["b"] = [0.01, 2.2]
+    assert point_volume_warnings(rec) == warnings
+
+
 def test_a_grid_levelset_shape_is_mapped_too():
     """A body whose initial shape is a grid level set (a grain's sampled outline): phi_0 is its
     C1 interpolant, evaluated at X clamped to its grid (positive beyond). A rotated disc comes
