@@ -212,11 +212,13 @@ class CutIntegration:
         cells = np.flatnonzero(kind == CUT)
         f = self.factor.x.array
         f[:] = 1.0
+        self.fraction = np.ones(ncells)  # the share of each cell's area inside its body
         if len(cells):
             W = _cpp.cut_moment_weights(
                 np.ascontiguousarray(self.phi.x.array[pdofs[cells]]), np.ascontiguousarray(points)
             )
             f[qdofs[cells]] = W / wref
+            self.fraction[cells] = np.asarray(W).reshape(len(cells), -1).sum(axis=1) / wref.sum()
         self.kind = kind
         self.num_cut_cells = len(cells)
         self._keep = []

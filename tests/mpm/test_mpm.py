@@ -73,8 +73,12 @@ def test_levelset_windows_follow_a_translated_disc():
     shape = df.Circle((-1.5, 0.0), r)
     body = MPMBody("disc", 1, (E, 0.3), shape)
     sim = ImplicitMPM(
-        COMM, (lines, lines), [body], grid_scene(COMM, lines, lines, [("disc", 1)]),
-        dirichlet=bcs, **quiet,
+        COMM,
+        (lines, lines),
+        [body],
+        grid_scene(COMM, lines, lines, [("disc", 1)]),
+        dirichlet=bcs,
+        **quiet,
     )
     w0 = sim.windows[1]
     v0 = sim.levelsets[1].values
@@ -509,3 +513,39 @@ def test_each_levelset_update_moves_a_translated_disc(update):
         ring = np.array([-0.1, 0.0]) + r * np.stack([np.cos(t), np.sin(t)], axis=1)
         assert np.max(np.abs(sim.levelsets[1].evaluate(ring)[0])) < 0.01 * h
         assert np.ptp(areas) < 1e-9 * areas[0]
+
+
+def test_points_in_a_sliver_take_the_field_inward(monkeypatch):
+    """A block whose left side lies 5 % of a cell past a grid line: its points in those sliver
+    cells (material_points.SLIVER) take u and grad u from the cell one spacing inward. With
+    u = A x on the block's nodes and a garbage value on the slivers' outer nodes (held by the
+    ghost penalty alone in a solve), they get A x and A exactly; their own cell's gradient
+    would carry the garbage."""
+    import dolfinx_forms.mpm.material_points as mp
+
+    h = 0.1
+    lines = uniform_lines(-1.6, 1.6, h)
+    everywhere = lambda x: np.ones(x.shape[1], bool)  # noqa: E731
+    bcs = [Dirichlet(everywhere, c, 0.0) for c in range(2)]
+    body = MPMBody("block", 1, (1000.0, 0.3), df.Box((-0.5 - 0.05 * h, -0.43), (0.43, 0.43)))
+    sim = ImplicitMPM(
+        COMM, (lines, lines), [body], grid_scene(COMM, lines, lines, [("block", 1)]),
+        dirichlet=bcs, **quiet,
+    )  # fmt: skip
+    sim.step()
+    problem, pts = sim.problem, sim.points[1]
+    x = pts.x[pts.x[:, 0] < -0.5]
+    assert len(x) > 0
+    cells = mp.grid_locator(problem.scene, 1, 1).locate(x, h)[0]
+    assert np.all(problem.integration.fraction[cells] < mp.SLIVER)
+    A = np.array([[0.011, -0.004], [0.003, 0.007]])
+    X = problem.V.tabulate_dof_coordinates()[:, :2]
+    u = X @ A.T
+    u[X[:, 0] < -0.55] += 1.0  # the slivers' outer nodes
+    problem.u.x.array[:] = u.ravel()
+    du, grad, _ = mp.displacement_at(problem, 1, x, h)
+    assert np.abs(du - x @ A.T).max() <= 1e-13
+    assert np.abs(grad - A).max() <= 1e-12
+    monkeypatch.setattr(mp, "SLIVER", 0.0)  # each point its own cell: the garbage shows
+    grad = mp.displacement_at(problem, 1, x, h)[1]
+    assert np.abs(grad - A).max() > 1.0
