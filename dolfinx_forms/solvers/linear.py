@@ -485,36 +485,34 @@ def contact_dofs(problem):
     return (nodes[:, None] * problem.bs + np.arange(problem.bs)).ravel().astype(np.int32)
 
 
-def choose(problem, kind="auto", petsc_options=None):
+def choose(problem, kind="auto", petsc_options=None, picked=None):
     """kind: "auto", "condensed" (raises where it does not apply), "factorised" or "iterative".
     "auto": Iterative for a body-fitted scene of at least ITERATIVE_MIN_DOFS dofs with the
     default solver options (or for options naming pc_type=gamg); else Condensed for a linear
     bulk on one process with the default direct solver and a contact block of m dofs well
-    below the n dofs, m^3 <= defaults.TUNING.condensed_cost n^1.5; Factorised otherwise."""
-    picked, dofs = _pick(problem, kind, petsc_options)
+    below the n dofs, m^3 <= defaults.TUNING.condensed_cost n^1.5; Factorised otherwise.
+    picked: `pick`'s answer for these options, if the caller has it (the contact dofs once)."""
+    picked, dofs = picked or pick(problem, kind, petsc_options)
     if picked == "iterative":
         return Iterative(problem, _without_direct(petsc_options) if kind == "iterative" else (
             petsc_options if (petsc_options or {}).get("pc_type") == "gamg" else None))  # fmt: skip
     if picked == "condensed":
         return Condensed(problem, dofs, petsc_options)
-    default = not petsc_options or {**DEFAULT_OPTIONS, **petsc_options} == DEFAULT_OPTIONS
-    symmetric = default and problem.mu == 0  # Factorised's LDL^T, LU once J is not symmetric
+    # Factorised's LDL^T, LU once J is not symmetric
+    symmetric = _default(petsc_options) and problem.mu == 0
     return Factorised(problem, petsc_options, symmetric)
 
 
-def picks(problem, kind="auto", petsc_options=None):
-    """The solver `choose` builds for these options: "factorised", "condensed" or
-    "iterative" (ValueError where "condensed" does not apply). Only a factorisation of the
-    whole J pays for the explicit zeros of its sparsity (`ContactProblem.coupled`)."""
-    return _pick(problem, kind, petsc_options)[0]
-
-
-def _pick(problem, kind, petsc_options):
+def pick(problem, kind="auto", petsc_options=None):
+    """(the solver `choose` builds for these options: "factorised", "condensed" or
+    "iterative", Condensed's contact dofs or None); ValueError where "condensed" does not
+    apply. Only a factorisation of the whole J pays for the explicit zeros of its sparsity
+    (`ContactProblem.coupled`)."""
     if kind not in KINDS:
         raise ValueError(f"linear_solver: {', '.join(map(repr, KINDS))}, not {kind!r}")
     if kind in ("factorised", "iterative"):
         return kind, None
-    default = not petsc_options or {**DEFAULT_OPTIONS, **petsc_options} == DEFAULT_OPTIONS
+    default = _default(petsc_options)
     body_fitted = getattr(problem.scene, "cut", None) is None
     if kind == "auto" and (
         (petsc_options or {}).get("pc_type") == "gamg"
@@ -532,7 +530,7 @@ def _pick(problem, kind, petsc_options):
 def _not_condensed(problem, kind, petsc_options):
     """(why Condensed does not apply, or does not pay under "auto"; None where it does, the
     contact dofs)."""
-    default = not petsc_options or {**DEFAULT_OPTIONS, **petsc_options} == DEFAULT_OPTIONS
+    default = _default(petsc_options)
     why = None
     if problem.comm.size > 1:
         why = "MUMPS Schur complements are serial"
@@ -548,6 +546,11 @@ def _not_condensed(problem, kind, petsc_options):
     if why is None and kind == "auto" and costly:
         why = f"{m} contact dofs of {n}: a dense update would cost more than a factorisation"
     return why, dofs
+
+
+def _default(petsc_options):
+    """Whether the options are the default direct solver's (none, or equal to them)."""
+    return not petsc_options or {**DEFAULT_OPTIONS, **petsc_options} == DEFAULT_OPTIONS
 
 
 def _without_direct(petsc_options):

@@ -105,13 +105,14 @@ class ContactProblem:
             )
         self.coupling_gap = None if so.coupling_gap is None else float(so.coupling_gap) * h
         self.coupling_rebuilds = 0  # matrices built again for a point outside the sparsity
-        self._coupled = linear.picks(self, so.linear_solver, so.petsc_options) == "factorised"
+        picked = linear.pick(self, so.linear_solver, so.petsc_options)
+        self._coupled = picked[0] == "factorised"
         self.coupled = self._coupling_points()
         with self.phase("assembly"):
             self._matrices(fo.ghost_penalty)
         self.retired = [0, 0]  # factorisations of the linear solvers a band growth replaced
         with self.phase("solve"):  # the condensed bulk is factorised here, once
-            self.linear = linear.choose(self, so.linear_solver, so.petsc_options)
+            self.linear = linear.choose(self, so.linear_solver, so.petsc_options, picked)
         self.control = None  # force_control.ForceControl while a force-controlled stage runs
         self.u_committed = self.u.x.array.copy()
         self.lam = 0.0
@@ -158,16 +159,16 @@ class ContactProblem:
         self.bc_owned = all_bc[all_bc < self.n_owned].astype(np.int32)
         self.bc_global = (self.bc_owned + imap.local_range[0] * self.bs).astype(np.int32)
 
-    def _coupling_points(self, gap=None):
-        """Per pair, the law points whose tangent blocks the sparsity holds: those with a gap
-        below `gap` before the step's deformation (`ContactSet.law_gaps0`; default the larger of
-        coupling_gap and predictor_gap); None (every law point) without a coupling_gap or where
-        the linear solver is not `Factorised`."""
+    def _coupling_points(self):
+        """Per pair, a mask of the law points whose tangent blocks the sparsity holds: those
+        with a gap below the larger of coupling_gap and predictor_gap before the step's
+        deformation (`ContactSet.law_gaps0`); None (every law point) without a coupling_gap or
+        where the linear solver is not `Factorised`."""
         if self.coupling_gap is None or not self._coupled:
             return None
         # the predictor's first tangent holds the touching points too
-        gap = max(self.coupling_gap, self.predictor_gap) if gap is None else gap
-        return [np.flatnonzero(self.contact.law_gaps0(k) < gap) for k in range(len(self.pairs))]
+        gap = max(self.coupling_gap, self.predictor_gap)
+        return [self.contact.law_gaps0(k) < gap for k in range(len(self.pairs))]
 
     def _outside_coupling(self):
         """After a contact assembly into J: per pair, the law points that put a tangent block
@@ -175,24 +176,18 @@ class ContactProblem:
         on any rank."""
         if self.coupled is None:
             return None
-        out = [
-            np.setdiff1d(np.flatnonzero(s["law_coupled"]), c, assume_unique=True)
-            for s, c in zip(self.contact.last, self.coupled)
-        ]
-        return out if self.comm.allreduce(any(len(o) for o in out), op=MPI.LOR) else None
+        out = [(s["law_coupled"] != 0) & ~c for s, c in zip(self.contact.last, self.coupled)]
+        return out if self.comm.allreduce(any(o.any() for o in out), op=MPI.LOR) else None
 
     def _grow_coupling(self, outside):
         """The sparsity grown by the points `outside` and by every law point whose current gap
         is below the largest of theirs (or coupling_gap); matrices and solver built again."""
         gaps = [s["law_g_n"] for s in self.contact.last]
         reach = max(
-            [self.coupling_gap] + [float(np.max(g[o])) for g, o in zip(gaps, outside) if len(o)]
+            [self.coupling_gap] + [float(np.max(g[o])) for g, o in zip(gaps, outside) if o.any()]
         )
         reach = self.comm.allreduce(reach, op=MPI.MAX)
-        self.coupled = [
-            np.union1d(np.union1d(c, o), np.flatnonzero(g <= reach)).astype(np.int32)
-            for c, o, g in zip(self.coupled, outside, gaps)
-        ]
+        self.coupled = [c | o | (g <= reach) for c, o, g in zip(self.coupled, outside, gaps)]
         self.coupling_rebuilds += 1
         self._rebuild_linear(renew=True)
 
@@ -222,7 +217,8 @@ class ContactProblem:
             [self.V.dofmap._cpp_object, self.V.dofmap._cpp_object],
             {_dcpp.fem.IntegralType.cell},
         )
-        self.contact.insert_couplings(pattern, self.coupled)
+        points = None if self.coupled is None else [np.flatnonzero(c) for c in self.coupled]
+        self.contact.insert_couplings(pattern, points)
         if self.integration is not None and ghost_penalty > 0:
             self.integration.insert_ghost_couplings(pattern, self.V)
         pattern.assemble()
@@ -231,7 +227,7 @@ class ContactProblem:
         self.bulk.assemble_linear(self.K)
         self.K.assemblyBegin(PETSc.Mat.AssemblyType.FLUSH)  # assemble_matrix ends in INSERT
         self.K.assemblyEnd(PETSc.Mat.AssemblyType.FLUSH)
-        self.contact.add_zeros(self.K, self.coupled)
+        self.contact.add_zeros(self.K, points)
         self.K.assemble()
         self.J = self.K.duplicate(copy=False)
         self.J_key = None  # newton._keep: the key of the tangent J holds (None: none)
