@@ -24,6 +24,18 @@ def brazilian_disc(comm, R=10.0, h=0.2, step_displacement=0.02, steps=50, margin
     margin = 3 * h + step_displacement * steps if margin is None else margin
     xl = uniform_lines(-R - margin, R + margin, h)
     yl = uniform_lines(-R - margin, R + margin, h)
+    top, bottom = disc_platens(R, step_displacement)
+    zone = 0.25 * R + 4 * h  # where the contact zones can be: kept on rank 0
+    box = np.array(
+        [[[-zone, R - zone], [zone, R + margin]], [[-zone, -R - margin], [zone, -R + zone]]]
+    )
+    build = grid_scene(comm, xl, yl, [("disc", 1)], contact_box=box)
+    return (xl, yl), ("disc", 1, df.Circle((0.0, 0.0), R)), [top, bottom], build
+
+
+def disc_platens(R, step_displacement):
+    """The rigid half planes y > R (moved down by step_displacement per step) and y < -R
+    (fixed) about a disc of radius R centred at the origin: [top, bottom]."""
     ext = 100 * R
     top = RigidObstacle(
         "platen_top",
@@ -38,12 +50,7 @@ def brazilian_disc(comm, R=10.0, h=0.2, step_displacement=0.02, steps=50, margin
         bbox=[[-2 * R, -2 * R], [2 * R, -R]],
         center=(0.0, -R),
     )
-    zone = 0.25 * R + 4 * h  # where the contact zones can be: kept on rank 0
-    box = np.array(
-        [[[-zone, R - zone], [zone, R + margin]], [[-zone, -R - margin], [zone, -R + zone]]]
-    )
-    build = grid_scene(comm, xl, yl, [("disc", 1)], contact_box=box)
-    return (xl, yl), ("disc", 1, df.Circle((0.0, 0.0), R)), [top, bottom], build
+    return [top, bottom]
 
 
 def check_brazilian_disc(R, h, steps, step_displacement):
@@ -270,11 +277,15 @@ def width_at(levelset, y):
         return 0.0
     i0, i1 = inside[0], inside[-1]
     xl = np.asarray(xlines)
-    left = xl[i0] if i0 == 0 else xl[i0 - 1] + (xl[i0] - xl[i0 - 1]) * phi[i0 - 1] / (
-        phi[i0 - 1] - phi[i0]
+    left = (
+        xl[i0]
+        if i0 == 0
+        else xl[i0 - 1] + (xl[i0] - xl[i0 - 1]) * phi[i0 - 1] / (phi[i0 - 1] - phi[i0])
     )
-    right = xl[i1] if i1 == len(xl) - 1 else xl[i1] + (xl[i1 + 1] - xl[i1]) * phi[i1] / (
-        phi[i1] - phi[i1 + 1]
+    right = (
+        xl[i1]
+        if i1 == len(xl) - 1
+        else xl[i1] + (xl[i1 + 1] - xl[i1]) * phi[i1] / (phi[i1] - phi[i1 + 1])
     )
     return float(right - left)
 

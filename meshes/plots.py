@@ -79,6 +79,37 @@ def block_plots(run, folder, reference):
     _save(plt, fig, folder / "F_yy.png")
 
 
+def disc_crush_plots(run, folder, reference):
+    """demos/disc_crush.py: force.png (the top platen's force against compression, MPM and
+    the body-fitted reference at each mesh size) and plastic_zone.png (the plastic area
+    fraction of both over the steps; alpha at the material points at the last step)."""
+    plt = _pyplot()
+    p, rows = run.params, run.rows
+    c = np.array([r["compression"] for r in rows])
+    fig, ax = plt.subplots(figsize=(5, 4))
+    for h in sorted({r["h"] for r in reference}, reverse=True):
+        F = [r["force"] for r in reference if r["h"] == h]
+        ax.plot(c, F, "-", lw=1, label=f"body-fitted, h = {h:g}")
+    ax.plot(c, [r["force"] for r in rows], "o", ms=3, label=f"MPM, h = {p['h']:g}")
+    ax.set(xlabel="platen closure / diameter", ylabel="F (N/mm)", title=f"Disc crush ({p['law']})")
+    ax.legend()
+    _save(plt, fig, folder / "force.png")
+    if p["law"] != "j2":
+        return
+    fig, axes = plt.subplots(1, 2, figsize=(9, 4))
+    axes[0].plot(c, [r["plastic_fraction"] for r in rows], "o", ms=3, label="MPM")
+    axes[0].plot(c, [r["plastic_fraction_reference"] for r in rows], "k-", label="body-fitted")
+    axes[0].set(xlabel="platen closure / diameter", ylabel="plastic area fraction",
+                title="plastic zone (alpha > 0)")  # fmt: skip
+    axes[0].legend()
+    pts = run.sim.points[1]
+    image, extent = binned_mean(pts.x, pts.history[:, -1], p["h"])
+    sc = axes[1].imshow(image, extent=extent, origin="lower", cmap="magma")
+    axes[1].set(aspect="equal", title=f"alpha at the points, step {len(rows)}")
+    fig.colorbar(sc, ax=axes[1])
+    _save(plt, fig, folder / "plastic_zone.png")
+
+
 def flat_punch_plot(run, folder, tab, johnson):
     """demos/flat_punch.py: tractions.png, p_n and p_t at the contact points against
     johnson(x, a, P, nu, adhesive) -> (p, q)."""

@@ -63,12 +63,23 @@ def transfer_friction(sim, problem, keys):
             cs.set_start_tractions(k, tn, tt)
 
 
+def friction_record(problem, keys):
+    """{pair key: (points, elastic tangential gap, tau_n, tau_t)} of the converged step, on
+    every rank: what the next step's points start from (`transfer_friction`)."""
+    cs, out = problem.contact, {}
+    for k, g in enumerate(cs.pairs):
+        s = cs.committed[k]
+        if (cs.mu > 0 or cs.augmented) and s is not None and g.num_law_points == len(g.weights):
+            slip = cs.elastic_slip(k) if cs.mu > 0 else np.zeros(len(g.weights))
+            out[keys[k]] = (g.points.copy(), slip, s["law_tau_n"], s["law_tau_t"])
+    return {k: v for d in problem.comm.allgather(out) for k, v in d.items()}
+
+
 def contact_record(sim, problem, scene, keys):
     """Per pair: resultants, active zone, stick fraction; per obstacle: force and moment;
     the friction record for the next step (points moved by the mean step displacement)."""
     cs = problem.contact
     pairs = []
-    sim.friction = {}
     for k, g in enumerate(cs.pairs):
         s = cs.committed[k]
         active = s["state"] != 0
@@ -96,14 +107,10 @@ def contact_record(sim, problem, scene, keys):
                 num_points=int(len(w)),
             )
         )
-        if (cs.mu > 0 or cs.augmented) and g.num_law_points == len(w):
-            zero = np.zeros(len(w))
-            slip = cs.elastic_slip(k) if cs.mu > 0 else zero
-            sim.friction[keys[k]] = (g.points.copy(), slip, s["law_tau_n"], s["law_tau_t"])
+    sim.friction = friction_record(problem, keys)
     # each pair lives on one rank: share the records, in the order of one rank
     gathered = sim.comm.allgather(list(zip(cs.index, pairs)))
     pairs = [p for _, p in sorted((q for lst in gathered for q in lst), key=lambda q: q[0])]
-    sim.friction = {k: v for d in sim.comm.allgather(sim.friction) for k, v in d.items()}
     # contact resultants on each body: +sum w (tau_n n + tau_t t) on side i, the opposite on
     # side j; moment about the body's material-point centroid
     forces = {b.name: np.zeros(3) for b in sim.bodies}
@@ -115,9 +122,7 @@ def contact_record(sim, problem, scene, keys):
                 c = np.average(sim.points[b.tag].x, axis=0, weights=sim.points[b.tag].vol)
                 F, M = traction_resultant(g, s, side, p, c)
                 forces[name] += np.array([F[0], F[1], M])
-    body_forces = {
-        n: allreduce_array(sim.comm, v, MPI.SUM).tolist() for n, v in forces.items()
-    }
+    body_forces = {n: allreduce_array(sim.comm, v, MPI.SUM).tolist() for n, v in forces.items()}
     res = cs.obstacle_resultants()
     obstacles = {}
     for ob in sim.obstacles:
