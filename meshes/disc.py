@@ -44,8 +44,10 @@ def fitted_disc(comm, R=10.0, h=0.5, quads=True):
             gmsh.option.setNumber("Mesh.SubdivisionAlgorithm", 1 if quads else 0)
             gmsh.model.mesh.generate(2)
         disc = Body("disc", 1, df.Circle((0.0, 0.0), R), np.array([[-R, -R], [R, R]]))
-        zone = 0.9 * R + 4 * h  # contact zones up to the disc crushed to 40 % of its diameter
-        box = np.array([[[-zone, 0.0], [zone, R + h]], [[-zone, -R - h], [zone, 0.0]]])
+        # the cells that meet a platen up to a closure of half the diameter (material within
+        # about 60 degrees of a pole), on rank 0 where the contact is computed
+        x, y = 0.9 * R + 2 * h, 0.45 * R - 2 * h
+        box = np.array([[[-x, y], [x, R + h]], [[-x, -R - h], [x, -y]]])
         return scene_from_gmsh(comm, [disc], {}, [], h, contact_box=box)
 
 
@@ -78,19 +80,22 @@ REFERENCE_COLUMNS = [
 ]
 
 
-def crush_reference(comm, R, sizes, law, steps, step_displacement, log=None, **problem_kw):
+def crush_reference(
+    comm, R, sizes, law, steps, step_displacement, substeps=1, log=None, **problem_kw
+):
     """The body-fitted reference of the disc crush at each cell size in `sizes`: the disc of
     `fitted_disc` (quadrilaterals) between the platens of `meshes.mpm.disc_platens`, u_x = 0 on
     x = 0, `law` at finite strain on a mesh that follows the material
     (`fem.updated.UpdatedLagrangian`), one step per platen move. Returns the rows
-    (REFERENCE_COLUMNS; force: on the top platen, positive in compression) of every size.
+    (REFERENCE_COLUMNS; force: on the top platen, positive in compression) of every size;
+    substeps: load steps per platen move (`UpdatedLagrangian.step`).
     problem_kw: `solvers.options` keywords (an MPM's levelset_update is ignored)."""
     kw = {k: v for k, v in problem_kw.items() if k != "levelset_update"}  # the MPM's own
     return [row for h in sizes for row in _crush(comm, R, h, law, steps, step_displacement,
-                                                 log, kw)]  # fmt: skip
+                                                 substeps, log, kw)]  # fmt: skip
 
 
-def _crush(comm, R, h, law, steps, step_displacement, log, problem_kw):
+def _crush(comm, R, h, law, steps, step_displacement, substeps, log, problem_kw):
     from dolfinx_forms.fem.boundary import Dirichlet
     from dolfinx_forms.fem.updated import UpdatedLagrangian
     from meshes.mpm import disc_platens
@@ -107,7 +112,7 @@ def _crush(comm, R, h, law, steps, step_displacement, log, problem_kw):
     )
     rows = []
     for k in range(steps):
-        problem = ul.step()
+        problem = ul.step(substeps=substeps)
         top, bottom = ul.record["platen_top"], ul.record["platen_bottom"]
         rows.append(
             dict(

@@ -159,7 +159,8 @@ class UpdatedLagrangian:
             if len(loops) != 1:
                 raise ValueError(f"body {b.name!r}: one boundary loop expected, got {len(loops)}")
             nodes, ref = loops[0]
-            pos = np.where((nodes >= 0)[:, None], x[np.maximum(nodes, 0)], np.nan)
+            pos = np.full((len(nodes), 2), np.nan)
+            pos[nodes >= 0] = x[nodes[nodes >= 0]]
             # each node's position from a rank that holds it (the lowest)
             allpos = np.stack(self.comm.allgather(pos))
             have = ~np.isnan(allpos[..., 0])
@@ -169,9 +170,10 @@ class UpdatedLagrangian:
             b.bbox = np.array([cur.min(axis=0), cur.max(axis=0)])
 
     # ------------------------------------------------------------------ one step
-    def step(self, label=None):
+    def step(self, label=None, substeps=1):
         """One load step: solve for du on the current mesh, commit F_n and the history, move
-        the mesh and the obstacles. Returns the step's ContactProblem (kept until the next
+        the mesh and the obstacles; `substeps` load steps on the step's mesh (Newton's own
+        cut-back halves them further where it fails). Returns the step's ContactProblem (kept until the next
         step); its forces are in `record`: after the commit its residual is on the new mesh."""
         problem = ContactProblem(self.scene, self.updated, dirichlet=self.dirichlet,
                                  obstacles=self.obstacles, timer=self.timer, log=self.log,
@@ -179,7 +181,8 @@ class UpdatedLagrangian:
         keys = problem.contact.names(self.scene)
         try:
             records.transfer_friction(self, problem, keys)
-            problem.solve(1, 1.0, label=label or f"updated Lagrangian step {self.step_count + 1}")
+            label = label or f"updated Lagrangian step {self.step_count + 1}"
+            problem.solve(int(substeps), 1.0, label=label)
         except Exception:
             problem.destroy()
             raise
@@ -230,6 +233,8 @@ class UpdatedLagrangian:
         newF = self.Fn.x.array.reshape(-1, dd).copy()
         for t, law in self.updated.items():
             cells = self.scene.cell_tags.find(t).astype(np.int32)
+            if len(cells) == 0:  # none of this body on this rank
+                continue
             key = id(law)
             if self._commit.get(key, (None,))[0] is not du:
                 F, f, _ = law.kinematics(du)

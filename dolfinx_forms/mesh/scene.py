@@ -549,7 +549,7 @@ def scene_from_arrays(
     tdim = 2
     imap = mesh.topology.index_map(tdim)
     ncells = imap.size_local + imap.num_ghosts
-    dofs = mesh.geometry.dofmap.array.reshape(ncells, -1)
+    dofs = mesh.geometry.dofmap.array.reshape(ncells, 3 if cell_name == "triangle" else 4)
     centroid = mesh.geometry.x[dofs][..., :2].mean(axis=1)
     cvalues = np.zeros(ncells, np.int32)
     if ncells:

@@ -84,3 +84,19 @@ def test_disc_crush_reference_converges():
     order = np.log2(coarse / mid)
     assert np.all((order > 0.7) & (order < 1.5)), order
     assert np.all(mid / F[0.5] < 0.03)
+
+
+@pytest.mark.mpi
+def test_disc_crush_reference_on_two_ranks_equals_one():
+    """J2 with friction, 3 moves at h = 1: the 2-rank run (rank 1 without contact cells: the
+    contact box of meshes.disc) gives the forces and half-widths of each rank's own serial run
+    to 1e-9."""
+    assert MPI.COMM_WORLD.size == 2, "run under mpirun -n 2"
+    law = J2Plasticity(E, NU, 20.0, 100.0)
+    kw = dict(substeps=8, mu=0.3, eps0=0.2)
+    two, one = (
+        crush_reference(c, 10.0, [1.0], law, 3, 0.5, **kw) for c in (MPI.COMM_WORLD, MPI.COMM_SELF)
+    )
+    for a, b in zip(two, one):
+        for k in ("force", "force_bottom", "half_width", "plastic_fraction"):
+            assert a[k] == pytest.approx(b[k], rel=1e-9, abs=1e-12), k
