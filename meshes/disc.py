@@ -15,9 +15,13 @@ import numpy as np
 from dolfinx_forms.mesh.scene import Body, check_cells, gmsh_model, scene_from_gmsh, summary
 
 
+# the ranks that compute the top and the bottom platen's contact (modulo the ranks)
+PLATEN_RANKS = (0, 1)
+
+
 def fitted_disc(comm, R=10.0, h=0.5, quads=True):
-    """The Scene of the disc (body "disc", tag 1; boundary "axis": the facets on x = 0, none:
-    the line is inside) with cells of size about h; contact on rank 0 near both poles."""
+    """The Scene of the disc (body "disc", tag 1) with cells of size about h; the cells near
+    the two poles on the ranks PLATEN_RANKS (`contact_ranks`)."""
     import dolfinx_forms as df
 
     check_cells("fitted_disc", 1.3 * np.pi * (R / h) ** 2 if h > 0 else 0.0)
@@ -45,10 +49,19 @@ def fitted_disc(comm, R=10.0, h=0.5, quads=True):
             gmsh.model.mesh.generate(2)
         disc = Body("disc", 1, df.Circle((0.0, 0.0), R), np.array([[-R, -R], [R, R]]))
         # the cells that meet a platen up to a closure of half the diameter (material within
-        # about 60 degrees of a pole), on rank 0 where the contact is computed
+        # about 60 degrees of a pole): the top ones on rank 0, the bottom ones on rank 1 (as
+        # ghosts where another rank owns them), where the two contacts are computed
         x, y = 0.9 * R + 2 * h, 0.45 * R - 2 * h
         box = np.array([[[-x, y], [x, R + h]], [[-x, -R - h], [x, -y]]])
-        return scene_from_gmsh(comm, [disc], {}, [], h, contact_box=box)
+        return scene_from_gmsh(
+            comm, [disc], {}, [], h, contact_box=dict(boxes=box, owners=PLATEN_RANKS)
+        )
+
+
+def contact_ranks(comm):
+    """The ContactProblem contact_rank map of `fitted_disc`: each platen's pair on its rank."""
+    ranks = [r % comm.size for r in PLATEN_RANKS]
+    return {(0, "platen_top"): ranks[0], (0, "platen_bottom"): ranks[1]}
 
 
 def plastic_fraction(ul, tag=1):
@@ -91,6 +104,7 @@ def crush_reference(
     substeps: load steps per platen move (`UpdatedLagrangian.step`).
     problem_kw: `solvers.options` keywords (an MPM's levelset_update is ignored)."""
     kw = {k: v for k, v in problem_kw.items() if k != "levelset_update"}  # the MPM's own
+    kw.setdefault("contact_rank", contact_ranks(comm))
     return [row for h in sizes for row in _crush(comm, R, h, law, steps, step_displacement,
                                                  substeps, log, kw)]  # fmt: skip
 

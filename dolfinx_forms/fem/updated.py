@@ -22,6 +22,7 @@ moves every quadrature point by du, exactly.
 
 from __future__ import annotations
 
+import basix
 import numpy as np
 import ufl
 from dolfinx import fem
@@ -135,10 +136,7 @@ class UpdatedLagrangian:
                     h.x.array.reshape(-1, k)[:] = np.asarray(w.initial_history, float)
                 shared[key] = (h, UpdatedLaw(w, self.Fn, h, self.degree))
             self.history[t], self.updated[t] = shared[key]
-        self.points = CELLS[cell.cellname()]
-        import basix
-
-        self.qpoints = basix.make_quadrature(self.points, self.degree)[0]
+        self.qpoints = basix.make_quadrature(CELLS[cell.cellname()], self.degree)[0]
         tdim = self.mesh.topology.dim
         imap = self.mesh.topology.index_map(tdim)
         self.cells = np.arange(imap.size_local + imap.num_ghosts, dtype=np.int32)
@@ -173,8 +171,9 @@ class UpdatedLagrangian:
     def step(self, label=None, substeps=1):
         """One load step: solve for du on the current mesh, commit F_n and the history, move
         the mesh and the obstacles; `substeps` load steps on the step's mesh (Newton's own
-        cut-back halves them further where it fails). Returns the step's ContactProblem (kept until the next
-        step); its forces are in `record`: after the commit its residual is on the new mesh."""
+        cut-back halves them further where it fails). Returns the step's ContactProblem (kept
+        until the next step); its forces are in `record`: after the commit its residual is on
+        the new mesh."""
         problem = ContactProblem(self.scene, self.updated, dirichlet=self.dirichlet,
                                  obstacles=self.obstacles, timer=self.timer, log=self.log,
                                  **options(**self.problem_kw))  # fmt: skip
@@ -229,7 +228,8 @@ class UpdatedLagrangian:
         """F_n <- (I + grad du) F_n and h_n <- history_update at every quadrature point, then
         the nodes move by du (first-order geometry: node i of a cell is dof i of P1/Q1)."""
         d, dd = self.d, self.d * self.d
-        dofs_F = self.Fn.function_space.dofmap.list.array.reshape(len(self.cells), -1)
+        nq = len(self.qpoints)  # explicit shapes: a rank may hold no cells
+        dofs_F = self.Fn.function_space.dofmap.list.array.reshape(len(self.cells), nq)
         newF = self.Fn.x.array.reshape(-1, dd).copy()
         for t, law in self.updated.items():
             cells = self.scene.cell_tags.find(t).astype(np.int32)
@@ -244,19 +244,20 @@ class UpdatedLagrangian:
                     new = law.law.history_update(F, f, h)
                     parts += [new[i] for i in range(law.law.history_size)]
                 self._commit[key] = (du, fem.Expression(ufl.as_vector(parts), self.qpoints))
-            vals = self._commit[key][1].eval(cells).reshape(len(cells), len(self.qpoints), -1)
+            vals = self._commit[key][1].eval(cells).reshape(len(cells), nq, -1)
             newF[dofs_F[cells].ravel()] = vals[:, :, :dd].reshape(-1, dd)
             h = self.history[t]
             if h is not None:
                 k = law.law.history_size
-                hd = h.function_space.dofmap.list.array.reshape(len(self.cells), -1)
+                hd = h.function_space.dofmap.list.array.reshape(len(self.cells), nq)
                 h.x.array.reshape(-1, k)[hd[cells].ravel()] = vals[:, :, dd:].reshape(-1, k)
         self.Fn.x.array[:] = newF.ravel()
         # move the nodes: geometry node of cell c, local i <-> dof of V of cell c, local i
         V = du.function_space
         bs = V.dofmap.index_map_bs
-        gmap = self.mesh.geometry.dofmap.array.reshape(len(self.cells), -1)
-        vmap = V.dofmap.list.array.reshape(len(self.cells), -1)
+        nv = V.dofmap.dof_layout.num_dofs
+        gmap = self.mesh.geometry.dofmap.array.reshape(len(self.cells), nv)
+        vmap = V.dofmap.list.array.reshape(len(self.cells), nv)
         u = du.x.array.reshape(-1, bs)
         self.mesh.geometry.x[gmap.ravel(), :d] += u[vmap.ravel()]
         self.update_shapes()

@@ -88,15 +88,14 @@ def test_disc_crush_reference_converges():
 
 @pytest.mark.mpi
 def test_disc_crush_reference_on_two_ranks_equals_one():
-    """J2 with friction, 3 moves at h = 1: the 2-rank run (rank 1 without contact cells: the
-    contact box of meshes.disc) gives the forces and half-widths of each rank's own serial run
-    to 1e-9."""
+    """J2 with friction, 3 moves at h = 1 and 2.5 (each platen's contact on its own rank,
+    meshes.disc.contact_ranks; at 2.5 the two contact zones hold every cell): the 2-rank run
+    gives the forces and half-widths of each rank's own serial run to 1e-9."""
     assert MPI.COMM_WORLD.size == 2, "run under mpirun -n 2"
     law = J2Plasticity(E, NU, 20.0, 100.0)
     kw = dict(substeps=8, mu=0.3, eps0=0.2)
-    two, one = (
-        crush_reference(c, 10.0, [1.0], law, 3, 0.5, **kw) for c in (MPI.COMM_WORLD, MPI.COMM_SELF)
-    )
+    two, one = (crush_reference(c, 10.0, [1.0, 2.5], law, 3, 0.5, **kw)
+                for c in (MPI.COMM_WORLD, MPI.COMM_SELF))  # fmt: skip
     for a, b in zip(two, one):
         for k in ("force", "force_bottom", "half_width", "plastic_fraction"):
             assert a[k] == pytest.approx(b[k], rel=1e-9, abs=1e-12), k
