@@ -81,18 +81,26 @@ def block_plots(run, folder, reference):
 
 def disc_crush_plots(run, folder, reference):
     """demos/disc_crush.py: force.png (the top platen's force against compression, MPM and
-    the body-fitted reference at each mesh size) and plastic_zone.png (the plastic area
+    the body-fitted reference at each mesh size, and each against the finest) and plastic_zone.png (the plastic area
     fraction of both over the steps; alpha at the material points at the last step)."""
     plt = _pyplot()
     p, rows = run.params, run.rows
     c = np.array([r["compression"] for r in rows])
-    fig, ax = plt.subplots(figsize=(5, 4))
-    for h in sorted({r["h"] for r in reference}, reverse=True):
-        F = [r["force"] for r in reference if r["h"] == h]
+    sizes = sorted({r["h"] for r in reference}, reverse=True)
+    finest = np.array([r["force"] for r in reference if r["h"] == sizes[-1]])
+    fig, (ax, dx) = plt.subplots(1, 2, figsize=(10, 4))
+    for h in sizes:
+        F = np.array([r["force"] for r in reference if r["h"] == h])
         ax.plot(c, F, "-", lw=1, label=f"body-fitted, h = {h:g}")
-    ax.plot(c, [r["force"] for r in rows], "o", ms=3, label=f"MPM, h = {p['h']:g}")
+        dx.plot(c, 100 * (F / finest - 1), "-", lw=1, label=f"body-fitted, h = {h:g}")
+    F = np.array([r["force"] for r in rows])
+    ax.plot(c, F, "o", ms=3, label=f"MPM, h = {p['h']:g}")
+    dx.plot(c, 100 * (F / finest - 1), "o", ms=3, label=f"MPM, h = {p['h']:g}")
     ax.set(xlabel="platen closure / diameter", ylabel="F (N/mm)", title=f"Disc crush ({p['law']})")
+    dx.set(xlabel="platen closure / diameter", ylabel="F / F_finest - 1 (%)",
+           title="against the finest body-fitted run")  # fmt: skip
     ax.legend()
+    dx.legend()
     _save(plt, fig, folder / "force.png")
     if p["law"] != "j2":
         return
