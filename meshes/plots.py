@@ -79,10 +79,15 @@ def block_plots(run, folder, reference):
     _save(plt, fig, folder / "F_yy.png")
 
 
-def disc_crush_plots(run, folder, reference):
-    """demos/disc_crush.py: force.png (the top platen's force against compression, MPM and
+def disc_crush_outputs(run, folder, reference):
+    """demos/disc_crush.py: reference.csv (every level of the body-fitted reference,
+    meshes.disc.REFERENCE_COLUMNS), force.png (the top platen's force against compression, MPM and
     the body-fitted reference at each mesh size, and each against the finest) and plastic_zone.png (the plastic area
     fraction of both over the steps; alpha at the material points at the last step)."""
+    from dolfinx_forms.io.output import write_table
+    from meshes.disc import REFERENCE_COLUMNS
+
+    write_table(folder / "reference.csv", REFERENCE_COLUMNS, reference)
     plt = _pyplot()
     p, rows = run.params, run.rows
     c = np.array([r["compression"] for r in rows])

@@ -26,16 +26,15 @@ import basix
 import numpy as np
 import ufl
 from dolfinx import fem
-from mpi4py import MPI
 
 from dolfinx_forms import _cpp
-from dolfinx_forms.common import allreduce_array
+from dolfinx_forms.fem import jit_memo
 from dolfinx_forms.fem.history import CELLS
 from dolfinx_forms.fem.laws import as_law, law_key
 from dolfinx_forms.mpm import records
 from dolfinx_forms.mpm.finite_strain import UpdatedLaw
 from dolfinx_forms.solvers.options import options
-from dolfinx_forms.solvers.problem import ContactProblem, zone_ends
+from dolfinx_forms.solvers.problem import ContactProblem
 
 
 def boundary_loops(mesh, cell_tags, tag):
@@ -102,6 +101,7 @@ class UpdatedLagrangian:
 
     def __init__(self, scene, laws, *, obstacles=(), dirichlet=(), degree=2, reactions=(),
                  timer=None, log=print, **problem_kw):  # fmt: skip
+        jit_memo.install()  # new forms every step: FFCx's answers kept in memory
         self.scene, self.mesh, self.comm = scene, scene.mesh, scene.mesh.comm
         if self.mesh.geometry.cmap.degree != 1:
             raise ValueError("UpdatedLagrangian: first-order geometry only")
@@ -204,22 +204,16 @@ class UpdatedLagrangian:
         return problem
 
     def _record(self, problem, keys):
-        """{obstacle: dict(fx, fy, half_width)}: the force on each obstacle and half the
-        extent in x of its active contact zone (all ranks)."""
+        """{obstacle: dict(fx, fy, moment, half_width)}: the force on each obstacle and half
+        the extent in x of its active contact zone; {boundary: reaction} (all ranks)."""
         cs, out = problem.contact, {}
-        res = cs.obstacle_resultants()
-        for k, g in enumerate(cs.pairs):
-            s = cs.committed[k]
-            if g.obstacle is None or s is None:
-                continue
-            order = np.argsort(g.points[:, 0])
-            xl, xr = zone_ends(g.points[order, 0], (s["state"] != 0)[order], s["g_n"][order])
-            out[keys[k][1]] = 0.0 if xl is None else 0.5 * (xr - xl)
+        for k, (g, s) in enumerate(zip(cs.pairs, cs.committed)):
+            if g.obstacle is not None and s is not None:
+                out[keys[k][1]] = records.half_width(g, s)
         widths = {k: v for d in self.comm.allgather(out) for k, v in d.items()}
-        rec = {}
-        for ob in self.obstacles:
-            F = allreduce_array(self.comm, np.asarray(res[ob.name][0], float), MPI.SUM)
-            rec[ob.name] = dict(fx=float(F[0]), fy=float(F[1]), half_width=widths.get(ob.name, 0.0))
+        rec = records.obstacle_forces(problem, self.obstacles)
+        for name, r in rec.items():
+            r["half_width"] = widths.get(name, 0.0)
         for name in self.reactions:
             rec[name] = problem.reaction(name).tolist()
         return rec

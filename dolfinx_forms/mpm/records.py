@@ -85,8 +85,6 @@ def contact_record(sim, problem, scene, keys):
         active = s["state"] != 0
         w = g.weights
         pn, pt = -s["tau_n"], s["tau_t"]
-        order = np.argsort(g.points[:, 0])
-        xl, xr = zone_ends(g.points[order, 0], active[order], s["g_n"][order])
         wa = w[active]
         f = traction_resultant(g, s, "j")[0]  # on body j (the obstacle) from body i
         pairs.append(
@@ -103,7 +101,7 @@ def contact_record(sim, problem, scene, keys):
                 stick_fraction=float(np.sum(w[s["state"] == 1]) / np.sum(wa))
                 if active.any()
                 else 0.0,
-                half_width=0.0 if xl is None else 0.5 * (xr - xl),
+                half_width=half_width(g, s),
                 num_points=int(len(w)),
             )
         )
@@ -123,12 +121,24 @@ def contact_record(sim, problem, scene, keys):
                 F, M = traction_resultant(g, s, side, p, c)
                 forces[name] += np.array([F[0], F[1], M])
     body_forces = {n: allreduce_array(sim.comm, v, MPI.SUM).tolist() for n, v in forces.items()}
-    res = cs.obstacle_resultants()
-    obstacles = {}
-    for ob in sim.obstacles:
-        F, M = res[ob.name]
-        F = allreduce_array(sim.comm, np.asarray(F, float), MPI.SUM)
-        obstacles[ob.name] = dict(
-            fx=float(F[0]), fy=float(F[1]), moment=sim.comm.allreduce(M, op=MPI.SUM)
-        )
+    obstacles = obstacle_forces(problem, sim.obstacles)
     return dict(pairs=pairs, obstacles=obstacles, body_forces=body_forces)
+
+
+def half_width(g, s):
+    """Half the extent in x of the active contact zone of pair geometry g in state s."""
+    order = np.argsort(g.points[:, 0])
+    xl, xr = zone_ends(g.points[order, 0], (s["state"] != 0)[order], s["g_n"][order])
+    return 0.0 if xl is None else 0.5 * (xr - xl)
+
+
+def obstacle_forces(problem, obstacles):
+    """{obstacle name: dict(fx, fy, moment)} exerted on each obstacle (all ranks)."""
+    res, out = problem.contact.obstacle_resultants(), {}
+    for ob in obstacles:
+        F, M = res[ob.name]
+        F = allreduce_array(problem.comm, np.asarray(F, float), MPI.SUM)
+        out[ob.name] = dict(
+            fx=float(F[0]), fy=float(F[1]), moment=problem.comm.allreduce(M, op=MPI.SUM)
+        )
+    return out
