@@ -63,7 +63,7 @@ void bind_schur(py::module_& m) {
 
   m.def(
       "schur_update",
-      [](Mat F, const py::object& S) {
+      [](Mat F, const py::object& S, bool inverted) {
         // the (m, m) shape is known from the factor: check S before taking its complement
         const auto a = contact::python::input<double>(Arg{"schur_update", "S"}, S);
         SchurComplement schur(F);
@@ -78,10 +78,19 @@ void bind_schur(py::module_& m) {
               v(i, j) = s[i * m + j];
           v.restore();
         }
+        // PETSc factorises the Schur complement as it did the bulk (Cholesky for LDL^T), so a
+        // non-symmetric complement of a symmetric bulk comes in inverted: MatSolve then
+        // multiplies by it (MAT_FACTOR_SCHUR_INVERTED)
+        if (inverted) {
+          schur.restore(MAT_FACTOR_SCHUR_INVERTED);
+          return;
+        }
         schur.restore(MAT_FACTOR_SCHUR_UNFACTORED);
         petsc_check(MatFactorFactorizeSchurComplement(F), "MatFactorFactorizeSchurComplement");
       },
-      py::arg("F"), py::arg("S"),
+      py::arg("F"), py::arg("S"), py::arg("inverted") = false,
       "Replace the factor's Schur complement by the dense S (m, m) and factorise it: MatSolve "
-      "with F then solves the matrix whose Schur complement on the eliminated dofs is S.");
+      "with F then solves the matrix whose Schur complement on the eliminated dofs is S. "
+      "inverted: S is the inverse of that Schur complement (any S, whatever the factor's "
+      "symmetry).");
 }

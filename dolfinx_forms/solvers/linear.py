@@ -15,12 +15,12 @@ dofs of the cells that hold closest points: a few hundred of 1e4-1e6).
   expands through the one sparse factorisation (`_cpp.schur_factor`, `_cpp.schur_update`).
   Should one dense update take longer than twice that factorisation (m too large for n), it
   hands over to `Factorised` for the rest of the run.
-  A symmetric bulk (the linear laws) whose Dirichlet dofs are not contact dofs is factorised
-  as LDL^T (MUMPS Cholesky, ~0.7x LU's time and half its memory) with the Dirichlet rows *and
-  columns* eliminated; a solve then lifts the Dirichlet values (b_F - K_FD b_D). Its Schur
-  complement is factorised symmetric too, so a problem with friction starts with LU, and the
-  first non-symmetric J of a frictionless one (friction switched on later: slip's tangent)
-  refactorises the bulk once as LU for the rest of the run.
+  A symmetric bulk (the linear laws) is factorised as LDL^T (MUMPS Cholesky, ~0.7x LU's time
+  and half its memory) with the Dirichlet rows *and columns* eliminated; a solve then lifts
+  the Dirichlet values (b_F - K_FD b_D). PETSc would factorise its Schur complement as symmetric too, so S0 + dC_cc, non-symmetric with friction,
+  is handed over inverted (LAPACK; MatSolve then multiplies by it) where m is small enough for
+  that to pay (`INVERT_COST`); otherwise the first non-symmetric J refactorises the bulk once
+  as LU for the rest of the run.
 
 * `Iterative` (issue 12, "large problems"): CG preconditioned by PETSc's smoothed-aggregation
   AMG (GAMG) with the rigid-body modes as its near-null space, the AMG set-up reused across
@@ -36,12 +36,16 @@ import time
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
+from scipy.linalg import lapack
 
 from dolfinx_forms import _cpp, defaults
 
 DEFAULT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
 # a symmetric bulk or Schur complement: |A - A^T| <= this * |A| (round-off of the assembly)
 SYMMETRY_RTOL = 1e-12
+# Condensed: the break-even of S^-1 per Newton iteration against LU's sparse factorisation
+# per step (Brazilian disc, 5 Newton iterations a step) is ~18
+INVERT_COST = 15.0
 MAX_CONDENSED = 6000  # the dense m x m blocks (3 of them) stay below ~1 GB
 # "auto" condenses only where m^3 <= defaults.TUNING.condensed_cost n^1.5: a Newton iteration
 # costs a dense m x m update (~m^3) instead of a sparse factorisation (~n^1.5 in 2D)
@@ -204,9 +208,18 @@ class Condensed:
         self.IS = PETSc.IS().createGeneral(np.asarray(dofs, dtype=np.int32), comm=problem.comm)
         self.bc = np.asarray(problem.bc_global, dtype=np.int32)
         self.dirichlet, self.J = DirichletLift(problem), None  # symmetric: the lifting
-        # LDL^T needs K symmetric and J - K0 inside the (c, c) block of free dofs; with
-        # friction from the start (the MPM steps) J will not stay symmetric
-        symmetric = problem.mu == 0 and not np.isin(self.bc, dofs).any() and _symmetric(problem.K)
+        # LDL^T needs K symmetric and J - K0 inside the (c, c) block (friction: S^-1, setup)
+        # the contact dofs that are Dirichlet dofs (e.g. a symmetry line through the contact):
+        # their positions in S. J keeps their columns, the LDL^T factor does not; they meet
+        # x_D = 0 (the lifted right-hand side) either way, and are zeroed so that S is
+        # symmetric wherever J's free block is
+        self.fixed = np.flatnonzero(np.isin(np.asarray(dofs), self.bc))
+        symmetric = _symmetric(problem.K)
+        # a non-symmetric S (friction) on the LDL^T factor is inverted at each update (~4-7x
+        # a dense LU, measured at m = 250-2000): that pays against LU's sparse factorisation
+        # (~1.6x LDL^T's; Brazilian disc, m ~ 260, n = 16.4k) while m^3 <= INVERT_COST n^1.5
+        n = problem.K.getSize()[0]
+        self.invert = len(dofs) ** 3 <= INVERT_COST * n**1.5
         self.num_dofs = len(dofs)
         self.factorisations = 0  # sparse
         self.schur_factorisations = 0  # dense, m x m
@@ -253,15 +266,16 @@ class Condensed:
         self.operator = next(_OPERATORS)
         t0 = time.perf_counter()
         Jcc = J.createSubMatrix(self.IS, self.IS)
-        self.S[...] = self.base
-        _add_sparse(self.S, Jcc)
-        if self.symmetric and not _symmetric(Jcc):  # the base is symmetric
-            self._factor(False)  # friction on: LU from here on, with LU's S0
-            self.key, t0 = key, time.perf_counter()
-            self.S[...] = self.base
-            _add_sparse(self.S, Jcc)
+        inverted = not self._schur(Jcc) and self.symmetric
+        if inverted and not self.invert:  # friction on, m too large to invert S per iteration
+            self._factor(False)  # LU from here on, with LU's S0
+            self.key, t0, inverted = key, time.perf_counter(), False
+            self._schur(Jcc)
         destroy(Jcc)
-        _cpp.schur_update(self.F, self.S)
+        if inverted:  # PETSc would factorise S as symmetric: hand it S^-1
+            _cpp.schur_update(self.F, _invert(self.S), inverted=True)
+        else:
+            _cpp.schur_update(self.F, self.S)
         self.schur_factorisations += 1
         # m too large for its n (timer noise aside: twice, and 50 ms): refactorise instead
         if time.perf_counter() - t0 > max(2.0 * self.t_factor, self.min_handover):
@@ -274,12 +288,24 @@ class Condensed:
             self.full.operator = self.operator
             return
 
+    def _schur(self, Jcc):
+        """S = S0 + (J_cc - K0_cc) into self.S; whether it is symmetric (with the LDL^T factor:
+        J's Dirichlet columns eliminated first, as the factor's are)."""
+        S = self.S
+        S[...] = self.base
+        _add_sparse(S, Jcc)
+        if not self.symmetric:
+            return False
+        S[:, self.fixed] = 0.0
+        S[self.fixed, self.fixed] = 1.0
+        return np.abs(S - S.T).max() <= SYMMETRY_RTOL * np.abs(S).sum(axis=1).max()
+
     def solve(self, b, x):
         if self.full is not None:
             return self.full.solve(b, x)
         if not self.symmetric:
             return self.F.solve(b, x)
-        rhs, lifted = self.dirichlet.rhs(self.J, b)  # J_FD = K_FD: no contact dof is Dirichlet
+        rhs, lifted = self.dirichlet.rhs(self.J, b)  # J's own J_FD (contact included)
         self.F.solve(rhs, x)
         self.dirichlet.finish(x, lifted)
 
@@ -469,6 +495,20 @@ def _add_sparse(D, A, scale=1.0):
     per (i, j): no duplicate indices in its CSR rows)."""
     ai, aj, av = A.getValuesCSR()
     D[np.repeat(np.arange(len(ai) - 1), np.diff(ai)), aj] += scale * av
+
+
+def _invert(S):
+    """S^-1 in S's own buffer (LAPACK getrf + getri on S^T, which is S's C-ordered buffer read
+    in Fortran order: a fresh m x m array per Newton iteration costs page faults at large m).
+    RuntimeError on an exactly singular S (a zero pivot), as PETSc's dense LU would."""
+    lu, piv, info = lapack.dgetrf(S.T, overwrite_a=True)
+    if info == 0:
+        inv, info = lapack.dgetri(lu, piv, overwrite_lu=True)
+    if info != 0:
+        raise RuntimeError(f"the contact dofs' Schur complement is singular (LAPACK info {info})")
+    if not np.shares_memory(inv, S):  # f2py copied: S^-1 = (S^T)^-1 transposed
+        S[...] = inv.T
+    return S
 
 
 def _symmetric(A):

@@ -35,6 +35,37 @@ def test_coarse_run_writes_the_contract(tmp_path):
         assert (out / f).exists(), f
 
 
+def test_condensed_ldlt_with_friction_and_symmetry_line(tmp_path, monkeypatch):
+    """The condensed bulk as LDL^T with friction (S^-1 handed to PETSc) and with the symmetry
+    line's Dirichlet dofs among the contact dofs (their columns eliminated in S): the same
+    steps as a full LU factorisation per Newton iteration. (This grid's n is too small for
+    S^-1 to pay: `INVERT_COST` raised.)"""
+    from dolfinx_forms.solvers import linear
+
+    monkeypatch.setattr(linear, "INVERT_COST", 1e9)
+    inverted, fixed = [], []
+    invert, init = linear._invert, linear.Condensed.__init__
+    monkeypatch.setattr(linear, "_invert", lambda S: inverted.append(len(S)) or invert(S))
+
+    def spy(self, *a, **k):
+        init(self, *a, **k)
+        fixed.append(len(self.fixed))
+
+    monkeypatch.setattr(linear.Condensed, "__init__", spy)
+    rows = {}
+    for solver in ("condensed", "factorised"):
+        out = tmp_path / solver
+        args = ["--h", "1", "--steps", "3", "--linear-solver", solver, "--out", str(out)]
+        assert demo.main(args) == 0
+        assert json.load(open(out / "metrics.json"))["solver"]["linear_solver"] == solver
+        rows[solver] = list(csv.DictReader(open(out / "steps.csv")))
+    assert inverted and min(fixed) > 0
+    for a, b in zip(rows["condensed"], rows["factorised"]):
+        assert a["newton_iterations"] == b["newton_iterations"]
+        for k in ("force_top", "force_bottom", "half_width_top"):
+            assert float(a[k]) == pytest.approx(float(b[k]), rel=1e-8), k
+
+
 @pytest.mark.parametrize(
     "args, word",
     [

@@ -79,6 +79,34 @@ def test_condensed_equals_factorised(kind):
 
 
 @pytest.mark.parametrize("kind", ["conforming", "cut"])
+def test_friction_on_the_symmetric_factor(kind, monkeypatch):
+    """m small enough for its n (`INVERT_COST`, raised here: these scenes are small): the bulk
+    stays LDL^T through the frictional stage, the non-symmetric Schur complement handed to PETSc
+    inverted; the same iterates and state as a full LU factorisation per iteration."""
+    monkeypatch.setattr(linear, "INVERT_COST", 1e9)
+    sc = scene(kind)
+    a, b = mindlin(sc, "condensed"), mindlin(sc, "factorised")
+    assert a.linear.name == "condensed" and a.linear.symmetric and a.factorisations == 1
+    assert not b.linear.symmetric  # LU since friction on
+    assert a.linear.schur_factorisations >= 3
+    ua, ub = a.u.x.array, b.u.x.array
+    assert np.abs(ua - ub).max() <= 1e-9 * np.abs(ub).max()
+    assert [s.iterations for s in a.steps] == [s.iterations for s in b.steps]
+    assert a.reached == pytest.approx(b.reached, rel=1e-9)
+
+
+def test_invert_in_place():
+    """linear._invert: S^-1 in S's buffer (C order), and a clear error on a singular S."""
+    rng = np.random.default_rng(0)
+    S = rng.random((40, 40)) + 40 * np.eye(40)
+    S0 = S.copy()
+    X = linear._invert(S)
+    assert X is S and np.abs(X @ S0 - np.eye(40)).max() < 1e-12
+    with pytest.raises(RuntimeError, match="singular"):
+        linear._invert(np.zeros((3, 3)))
+
+
+@pytest.mark.parametrize("kind", ["conforming", "cut"])
 def test_symmetric_factor_while_frictionless(kind):
     """Normal force only: the bulk stays factorised once, as LDL^T with the Dirichlet columns
     eliminated and the moving top's values lifted in each solve (force control moves them:
