@@ -245,6 +245,8 @@ class Steps:
             linear_solver=sim.problem.linear.name,  # the last step's
             condensed_dofs=int(getattr(sim.problem.linear, "num_dofs", 0)),
             cutbacks=int(sum(r["cutbacks"] for r in self.records)),
+            # sub-steps per step: a failed step is done again in halves (ImplicitMPM.step)
+            substeps=[r.get("substeps", 1) for r in self.records],
             factorisations=[r["factorisations"] for r in self.records],  # per step
             coupling_rebuilds=[r["coupling_rebuilds"] for r in self.records],  # per step
             warnings=[f"step {k}: {w}" for w, k in self.checks.items()],

@@ -23,7 +23,8 @@ rigid level sets (`obstacles.py`). One load step:
 
 Nothing persistent changes before step 4 converges, and `snapshot`/`restore` copy every piece
 of state (points, level sets, obstacle poses, friction record, counters): a rejected step leaves
-the simulation exactly as it was.
+the simulation exactly as it was. A quasi-static step that fails is done again in halves,
+each on its own cut cells (`step`, `max_splits`).
 
 Linear laws: small strain per step with the Jaumann update of the points' stress
 (material_points.py). Finite-strain laws (`Law.finite_strain`: NeoHookean, J2Plasticity, user
@@ -52,6 +53,7 @@ from dolfinx_forms.fem.cut import grid_cells, material_window
 from dolfinx_forms.fem.laws import as_law, law_key
 from dolfinx_forms.mpm import evolution, records
 from dolfinx_forms.mpm import finite_strain as fs
+from dolfinx_forms.solvers.newton import ContactSolverError
 from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 
@@ -68,6 +70,12 @@ class MPMBody:
 
 
 MAX_BAND_GROWTH = 4  # doublings of the contact band within one step (16 times the start)
+# halvings of a failed quasi-static step (`ImplicitMPM.step`): down to an eighth of it. The
+# neo-Hookean block of block_compression.py failed at 34 % in 20 steps and ran in 40.
+MAX_SPLITS = 3
+# step-record counters that add up over a step's sub-steps (the rest: the last sub-step's)
+_SUMMED = ("newton_iterations", "cutbacks", "factorisations", "coupling_rebuilds",
+           "mls_widened", "mls_F_nearest", "wall_s")  # fmt: skip
 
 
 def equilibrium_error(record):
@@ -128,6 +136,7 @@ class ImplicitMPM:
         reinit_drift=0.2,
         levelset_update=evolution.LEVELSET_UPDATES[0],
         dynamics=None,
+        max_splits=MAX_SPLITS,
         timer=None,
         log=print,
         **problem_kw,
@@ -171,6 +180,10 @@ class ImplicitMPM:
             raise ValueError(f"levelset_update must be one of {evolution.LEVELSET_UPDATES}")
         self.levelset_update = levelset_update
         self.dynamics = dynamics  # None: quasi-static; a mpm.dynamics.PointNewmark
+        if not (isinstance(max_splits, int) and 0 <= max_splits <= 10):
+            raise ValueError(f"ImplicitMPM: max_splits must be an integer in [0, 10], got "
+                             f"{max_splits!r}")  # fmt: skip
+        self.max_splits = max_splits  # halvings of a failed quasi-static step (`step`)
         self.timer = timer
         self.threads = worker_threads(comm)
         self.log = log if comm.rank == 0 else (lambda *a, **k: None)
@@ -188,6 +201,7 @@ class ImplicitMPM:
         # state the next step's points start from (records.transfer_friction)
         self.friction = {}
         self.step_count = 0
+        self._substep, self._made = 0, []  # the step in progress's sub-steps (`step`)
         self.problem = None
         self.scene = None
         self._key = None  # _scene_key of self.scene
@@ -224,14 +238,65 @@ class ImplicitMPM:
     def step(self):
         """One load step (module docstring). Returns the step record (dict). On failure
         (ContactSolverError, RuntimeError) the state is restored and the error re-raised.
+
+        A quasi-static step whose solve fails (Newton after its own cut-backs, a non-finite
+        residual, the geometry of its cut cells) is done again from the same state as two half
+        steps, each on the cut cells of its own start (the obstacles' motion and the Dirichlet
+        increments, which ramp with lam, go to lam = 1/2; the stress, F and history carried by
+        the points in between), down to 2^-max_splits of the step. The record is the last
+        sub-step's with the counters summed and `substeps` the number taken (1: not split).
+        Dynamics has its own step-size control (mpm/dynamics.py); a Dirichlet value given as a
+        nonzero number does not ramp with lam, so either keeps the step whole.
+
         A converged step whose active contact points reach the edge of the contact band (an
         initial gap above 0.9 band: Gamma_c may cut the contact zone off) is done again from
         the same state with the band doubled, up to MAX_BAND_GROWTH times; the record says
         which band it used (`band`)."""
         snap = self.snapshot()
+        kept = self.problem, self.scene, self._key
+        self._substep, self._made = 0, []  # the problems of the converged sub-steps
+        try:
+            records_ = self._advance(1.0, 0)
+        except Exception:
+            self.restore(snap)
+            for p in self._made:
+                p.destroy()
+            self.problem, self.scene, self._key = kept
+            raise
+        for p in [kept[0], *self._made[:-1]]:  # petsc4py frees no PETSc object by itself
+            if p is not None and p is not self.problem:
+                p.destroy()
+        record = records_[-1]
+        for k in _SUMMED:
+            record[k] = type(record[k])(sum(r[k] for r in records_))
+        record["residuals"] = [v for r in records_ for v in r["residuals"]]
+        record["substeps"] = len(records_)
+        self.step_count += 1
+        record["step"] = self.step_count
+        return record
+
+    def _splittable(self):
+        ramped = all(callable(d.value) or float(d.value) == 0.0 for d in self.dirichlet)
+        return self.dynamics is None and ramped
+
+    def _advance(self, fraction, depth):
+        """The records of `fraction` of the step, split in halves while it fails (`step`)."""
+        try:
+            return [self._band_step(fraction)]
+        except (ContactSolverError, RuntimeError) as e:
+            if depth >= self.max_splits or not self._splittable():
+                if depth == 0:
+                    raise
+                raise ContactSolverError(f"{e} (at 1/{2**depth} of the step)") from e
+            self.log(f"{e}; done again in two halves")
+        return self._advance(fraction / 2, depth + 1) + self._advance(fraction / 2, depth + 1)
+
+    def _band_step(self, fraction):
+        """`fraction` of the step, the band doubled while active points reach its edge."""
+        snap = self.snapshot()
         for attempt in range(MAX_BAND_GROWTH + 1):
             try:
-                record = self._step()
+                record = self._step(fraction)
             except Exception:
                 if getattr(self, "_pending", None) is not None:
                     self._pending.destroy()
@@ -240,6 +305,7 @@ class ImplicitMPM:
                 raise
             if attempt == MAX_BAND_GROWTH or not self.band_reached():
                 record["band"] = self.band
+                self._substep += 1
                 return record
             self.restore(snap)
             self.band *= 2.0
@@ -254,7 +320,8 @@ class ImplicitMPM:
                 near = True
         return bool(self.comm.allreduce(near, op=MPI.LOR))
 
-    def _step(self):
+    def _step(self, fraction=1.0):
+        """The solve and update of `fraction` of the step (lam from 0 to fraction)."""
         t0 = time.perf_counter()
         with self.phase("mesh"):
             pairs = self.candidate_pairs()
@@ -309,7 +376,8 @@ class ImplicitMPM:
         keys = problem.contact.names(scene)
         with self.phase("contact"):
             records.transfer_friction(self, problem, keys)
-        problem.solve(1, 1.0, label=f"MPM step {self.step_count + 1}")
+        label = f"MPM step {self.step_count + 1}" + (f" ({fraction:g})" if fraction < 1 else "")
+        problem.solve(1, fraction, label=label)
         # ---- converged: from here on the state changes
         record = records.contact_record(self, problem, scene, keys)
         record["support_forces"] = records.support_forces(self, problem, scene)
@@ -327,13 +395,13 @@ class ImplicitMPM:
                     mp.update(pts, du, grad, self.C[b.tag])
                 outside += n_out
                 moved.append(du)
-            if self.step_count == 0:
-                self.first_step_du = moved
+            if self.step_count == 0:  # the whole first step's, over its sub-steps
+                first = self._substep == 0
+                self.first_step_du = moved if first else [*map(np.add, self.first_step_du, moved)]
         with self.phase("evolution"):
             evo = evolution.evolve(self, problem, scene)
         for ob in self.obstacles:
-            ob.advance(1.0)
-        self.step_count += 1
+            ob.advance(fraction)
         if self.dynamics is not None:
             self.dynamics.time += self.dynamics.dt
             record["time"] = self.dynamics.time
@@ -341,12 +409,10 @@ class ImplicitMPM:
                 b.name: self.dynamics.kinetic_energy(self.points[b.tag], self.dynamics.rho[b.tag])
                 for b in self.bodies
             }
-        if self.problem is not None and self.problem is not problem:
-            self.problem.destroy()  # petsc4py frees no PETSc object by itself
+        self._made.append(problem)  # the step frees the problems it replaced (`step`)
         self.problem, self.scene, self._key, self._pending = problem, scene, key, None
         imap = problem.V.dofmap.index_map
         record.update(
-            step=self.step_count,
             newton_iterations=int(sum(s.iterations for s in problem.steps)),
             # |R| of every Newton iteration of the accepted solve (a cut-back's are dropped)
             residuals=[float(r) for s in problem.steps for r in s.residuals],

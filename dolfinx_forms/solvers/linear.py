@@ -17,10 +17,10 @@ dofs of the cells that hold closest points: a few hundred of 1e4-1e6).
   hands over to `Factorised` for the rest of the run.
   A symmetric bulk (the linear laws) is factorised as LDL^T (MUMPS Cholesky, ~0.7x LU's time
   and half its memory) with the Dirichlet rows *and columns* eliminated; a solve then lifts
-  the Dirichlet values (b_F - K_FD b_D). PETSc would factorise its Schur complement as symmetric too, so S0 + dC_cc, non-symmetric with friction,
-  is handed over inverted (LAPACK; MatSolve then multiplies by it) where m is small enough for
-  that to pay (`INVERT_COST`); otherwise the first non-symmetric J refactorises the bulk once
-  as LU for the rest of the run.
+  the Dirichlet values (b_F - K_FD b_D). PETSc would factorise its Schur complement as
+  symmetric too, so S0 + dC_cc, non-symmetric with friction, is handed over inverted (LAPACK;
+  MatSolve then multiplies by it) where m is small enough for that to pay (`INVERT_COST`);
+  otherwise the first non-symmetric J refactorises the bulk once as LU for the rest of the run.
 
 * `Iterative` (issue 12, "large problems"): CG preconditioned by PETSc's smoothed-aggregation
   AMG (GAMG) with the rigid-body modes as its near-null space, the AMG set-up reused across

@@ -213,7 +213,9 @@ def test_each_step_frees_the_problem_it_replaces(monkeypatch):
     sim.problem_kw["newton"] = NewtonOptions(max_iterations=1, max_cutbacks=0)
     with pytest.raises(ContactSolverError):
         sim.step()
-    assert len(destroyed) == 1 and destroyed[0] is not cur and destroyed[0].K is None
+    # the whole step and its halves down to 2^-max_splits: one problem each, all freed
+    assert len(destroyed) == sim.max_splits + 1
+    assert all(p is not cur and p.K is None for p in destroyed)
     assert sim.problem is cur and cur.K.handle != 0 and cur.J.handle != 0
 
 
@@ -549,3 +551,67 @@ def test_points_in_a_sliver_take_the_field_inward(monkeypatch):
     monkeypatch.setattr(mp, "SLIVER", 0.0)  # each point its own cell: the garbage shows
     grad = mp.displacement_at(problem, 1, x, h)[1]
     assert np.abs(grad - A).max() > 1.0
+
+
+def _disc(step_displacement, steps, **kw):
+    grid, (name, tag, shape), platens, build = brazilian_disc(
+        COMM, 10.0, 0.5, step_displacement, steps
+    )
+    sym = Dirichlet(lambda x: np.isclose(x[0], 0.0), 0, 0.0)
+    body = MPMBody(name, tag, (100e3, 0.3), shape)
+    return ImplicitMPM(COMM, grid, [body], build, obstacles=platens, dirichlet=[sym], mu=0.5,
+                       **quiet, **kw)  # fmt: skip
+
+
+def _fail_whole_steps(monkeypatch, below=1.0):
+    """ContactProblem.solve fails for every load level from `below` up (lam_end: the fraction
+    of the MPM step)."""
+    from dolfinx_forms.solvers.problem import ContactProblem
+
+    solve = ContactProblem.solve
+
+    def failing(self, num_steps=1, lam_end=1.0, *a, **k):
+        if lam_end >= below:
+            raise ContactSolverError(f"forced failure at {lam_end}")
+        return solve(self, num_steps, lam_end, *a, **k)
+
+    monkeypatch.setattr(ContactProblem, "solve", failing)
+
+
+def test_a_failed_step_is_done_again_in_halves(monkeypatch):
+    """A quasi-static step whose solve fails is done again as two half steps, each on the cut
+    cells of its own start: the state and forces of a run with half the platen travel per step
+    over twice the steps, in one record (`substeps` 2, the iterations summed)."""
+    ref = _disc(0.01, 4)
+    r_ref = [ref.step() for _ in range(2)]
+    sim = _disc(0.02, 2)
+    _fail_whole_steps(monkeypatch)
+    r = sim.step()
+    assert r["step"] == sim.step_count == 1 and r["substeps"] == 2
+    assert r["newton_iterations"] == sum(x["newton_iterations"] for x in r_ref)
+    assert len(r["residuals"]) == sum(len(x["residuals"]) for x in r_ref)
+    a, b = sim.points[1], ref.points[1]
+    assert np.abs(a.x - b.x).max() <= 1e-12 * 10.0
+    assert np.abs(a.stress - b.stress).max() <= 1e-8 * np.abs(b.stress).max()
+    for o, p in zip(sim.obstacles, ref.obstacles):
+        assert np.allclose(o.offset, p.offset, rtol=0, atol=1e-15)
+    for name, f in r_ref[-1]["obstacles"].items():
+        assert abs(f["fy"]) > 100  # loaded
+        for k in ("fx", "fy"):
+            assert r["obstacles"][name][k] == pytest.approx(f[k], rel=1e-8, abs=1e-8 * abs(f["fy"]))
+
+
+def test_a_step_failing_at_every_split_names_the_depth_and_is_undone(monkeypatch):
+    """Still failing at 2^-max_splits of the step: ContactSolverError naming that fraction, the
+    simulation as before the step. max_splits 0 keeps the step whole."""
+    sim = _disc(0.02, 2, max_splits=2)
+    _fail_whole_steps(monkeypatch, below=0.0)
+    with pytest.raises(ContactSolverError, match=r"forced failure at 0.25 \(at 1/4 of the step\)"):
+        sim.step()
+    assert sim.step_count == 0 and sim.points is None
+    assert all(np.array_equal(o.offset, np.zeros(2)) for o in sim.obstacles)
+    whole = _disc(0.02, 2, max_splits=0)
+    with pytest.raises(ContactSolverError, match=r"^forced failure at 1.0$"):
+        whole.step()
+    with pytest.raises(ValueError, match="max_splits"):
+        _disc(0.02, 2, max_splits=-1)
