@@ -270,6 +270,8 @@ class Condensed:
         if inverted and not self.invert:  # friction on, m too large to invert S per iteration
             self._factor(False)  # LU from here on, with LU's S0
             self.key, t0, inverted = key, time.perf_counter(), False
+            destroy(Jcc)
+            Jcc = J.createSubMatrix(self.IS, self.IS)  # its Dirichlet columns whole (LU)
             self._schur(Jcc)
         destroy(Jcc)
         if inverted:  # PETSc would factorise S as symmetric: hand it S^-1
@@ -289,16 +291,17 @@ class Condensed:
             return
 
     def _schur(self, Jcc):
-        """S = S0 + (J_cc - K0_cc) into self.S; whether it is symmetric (with the LDL^T factor:
-        J's Dirichlet columns eliminated first, as the factor's are)."""
-        S = self.S
-        S[...] = self.base
-        _add_sparse(S, Jcc)
-        if not self.symmetric:
-            return False
-        S[:, self.fixed] = 0.0
-        S[self.fixed, self.fixed] = 1.0
-        return np.abs(S - S.T).max() <= SYMMETRY_RTOL * np.abs(S).sum(axis=1).max()
+        """S = S0 + (J_cc - K0_cc) into self.S; whether it is symmetric. With the LDL^T factor
+        J's Dirichlet rows and columns are eliminated first (in Jcc), as the factor's are: S0
+        - K0_cc is symmetric, so S is wherever Jcc is."""
+        symmetric = False
+        if self.symmetric:
+            if len(self.fixed):
+                Jcc.zeroRowsColumns(self.fixed.astype(np.int32), diag=1.0)
+            symmetric = _symmetric(Jcc)
+        self.S[...] = self.base
+        _add_sparse(self.S, Jcc)
+        return symmetric
 
     def solve(self, b, x):
         if self.full is not None:
