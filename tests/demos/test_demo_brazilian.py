@@ -66,6 +66,40 @@ def test_condensed_ldlt_with_friction_and_symmetry_line(tmp_path, monkeypatch):
             assert float(a[k]) == pytest.approx(float(b[k]), rel=1e-8), k
 
 
+def test_a_split_step_is_one_row_with_its_substeps(tmp_path, monkeypatch):
+    """A step whose solve fails whole (forced here at its second step) is done in halves: one
+    steps.csv row with the platen at the step's full travel, `solver.substeps` [1, 2] and the
+    iterations of both halves (through the demo's Steps: mpm_run)."""
+    from dolfinx_forms.solvers.newton import ContactSolverError
+    from dolfinx_forms.solvers.problem import ContactProblem
+
+    solve, calls = ContactProblem.solve, []
+
+    def failing(self, num_steps=1, lam_end=1.0, *a, **k):
+        calls.append(lam_end)
+        if len(calls) == 2:
+            raise ContactSolverError("forced")
+        return solve(self, num_steps, lam_end, *a, **k)
+
+    rows = {}
+    for split in (False, True):
+        if split:
+            monkeypatch.setattr(ContactProblem, "solve", failing)
+        out = tmp_path / str(split)
+        assert demo.main(["--h", "1", "--steps", "2", "--out", str(out)]) == 0
+        rows[split] = list(csv.DictReader(open(out / "steps.csv")))
+        m = json.load(open(out / "metrics.json"))
+    assert calls == [1.0, 1.0, 0.5, 0.5]
+    assert m["solver"]["substeps"] == [1, 2] and len(rows[True]) == 2
+    a, b = rows[True][-1], rows[False][-1]
+    assert a["displacement"] == b["displacement"]
+    assert int(a["newton_iterations"]) > int(b["newton_iterations"])
+    # balanced and loaded further (the halves' answer is a path of its own on this coarse grid:
+    # 8 % off the whole step's at h = 1; two half steps equal it, tests/mpm/test_mpm.py)
+    assert float(a["force_top"]) == pytest.approx(float(a["force_bottom"]), rel=1e-6)
+    assert float(a["force_top"]) > float(rows[True][0]["force_top"]) > 0
+
+
 @pytest.mark.parametrize(
     "args, word",
     [
