@@ -96,12 +96,13 @@ def check_mesh_size(R, width, depth, h, zone, Ry=None):
 SIZE_OPTIONS = [
     ("--band", "(0, inf)", None,
      "largest initial gap covered by the contact surface (default: the gap at x = 1.6 a)"),
-    ("--width", "(0, inf)", None, "block width (default max(40, 40 a))"),
-    ("--depth", "(0, inf)", None, "block depth (default max(20, 20 a))"),
+    ("--width", "(0, inf)", None, "block width (default max(40, 40 a s), s = max(1, "
+     "sqrt(a / (20 h))): the block grows as h falls below a/20)"),
+    ("--depth", "(0, inf)", None, "block depth (default max(20, 20 a s))"),
     ("--zone", "[1, inf)", None, "half-width of the zone meshed at h, in units of the Hertz a "
      "(default 1.0 with the fast settings of path_defaults, else 1.2)"),
     ("--h-far", "(0, inf)", None,
-     "mesh size far from the contact (default min(R / 2, depth / 2, 100 h))"),
+     "mesh size far from the contact (default min(R / 2, depth / 2, 20 h))"),
     ("--grading", "(0, inf)", None,
      "size growth away from the zone: slope (body-fitted: default 0.5 with --mesher layers, "
      "0.25 with gmsh) or ratio of neighbouring cells (cut, > 1, default 2)"),
@@ -149,7 +150,8 @@ def path_defaults(args, given):
 def demo_sizes(args, hertz_a):
     """demos/hertz.py's mesher options checked (the layers: body-fitted triangles only; a cut
     grid's growth ratio --grading > 1), then its sizes that default from the Hertz half-width
-    hertz_a (--width max(40, 40 a), --depth max(20, 20 a), --h a/20; --zone in units of a)
+    hertz_a (--h a/20, --width max(40, 40 a s), --depth max(20, 20 a s) with s =
+    `block_growth`; --zone in units of a)
     and what the scenes can mesh: the zone inside both bodies, h within mesh_size_bounds.
     Returns (width, depth, h); a ValueError names the option to change."""
     a, cut = args, args.discretization == "cut"
@@ -159,10 +161,12 @@ def demo_sizes(args, hertz_a):
         )
     if a.grading is not None and cut and not a.grading > 1:
         raise ValueError(f"--grading: the cut grid's growth ratio must be > 1, got {a.grading:g}")
-    width, depth = a.width or max(40.0, 40 * hertz_a), a.depth or max(20.0, 20 * hertz_a)
-    zone = a.zone * hertz_a
     given = "--h" if a.h is not None else "--R, --load, --E (h = a/20 of the Hertz a)"
     h = a.h or hertz_a / 20
+    grow = block_growth(hertz_a, h)
+    width = a.width or max(40.0, 40 * hertz_a * grow)
+    depth = a.depth or max(20.0, 20 * hertz_a * grow)
+    zone = a.zone * hertz_a
     room = {"--R": a.R, "--width": width / 2, "--depth": depth}
     name = min(room, key=room.get)
     if not zone < room[name]:
@@ -182,6 +186,23 @@ def demo_sizes(args, hertz_a):
     return width, depth, h
 
 
+# demos/hertz.py's bulk, chosen so that its error falls with the contact's instead of
+# flooring it (the augmented Lagrangian, which adds no compliance, shows the floor; the penalty's
+# compliance partly cancels it). Far cells at most FAR_CELLS h: at R = 40, a/80, augmented, p(x)
+# 0.383 % with 100 h, 0.222 % with 20 h, 0.210 % with 10 h (154k, 292k dofs against 110k). The
+# block's finite size, O((a / depth)^2) against the half-space, falls like h when the block
+# grows as sqrt(a / h) (`block_growth`): with both, a/20 -> a/80 gives 0.78 -> 0.17 % (rate
+# 1.1) body-fitted and 0.98 -> 0.27 % (0.93) cut, against 0.93 -> 0.38 % and 1.03 -> 0.34 % with
+# 100 h and the a/20 block (docs/demos/convergence_study.md).
+FAR_CELLS = 20
+
+
+def block_growth(hertz_a, h):
+    """The factor s >= 1 of the default block (40 a s x 20 a s): 1 down to h = a/20, then
+    sqrt(a / (20 h)), so that the block's finite-size error, O((a / depth)^2), falls like h."""
+    return max(1.0, float(np.sqrt(hertz_a / (20.0 * h))))
+
+
 def demo_band(p, hertz_a):
     """The largest initial gap Gamma_c covers for the parameters p of demos/hertz.py: --band,
     default the gap at x = 1.6 a."""
@@ -195,7 +216,7 @@ def scene_sizes(p, hertz_a):
     cut = p["discretization"] == "cut"
     zone, band = p["zone"] * hertz_a, demo_band(p, hertz_a)
     # the far field coarsens with h, so that its error falls with h's (fixed h_far: a floor)
-    h_far = p["h_far"] or min(p["R"] / 2, p["depth"] / 2, 100 * p["h"])
+    h_far = p["h_far"] or min(p["R"] / 2, p["depth"] / 2, FAR_CELLS * p["h"])
     # body-fitted slope 0.5 instead: the same error at a/20 but a floor of 0.55 % from a/40
     growth = p["grading"] or (2.0 if cut else 0.25)
     size = {k: p[k] for k in ("R", "width", "depth", "h")}

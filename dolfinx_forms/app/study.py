@@ -343,13 +343,13 @@ VARIANTS = {  # name -> hertz.py arguments selecting the discretisation
     "q1-cut-aug": ["--discretization", "cut", "--enforcement", "augmented"],
 }
 # the bulk of a convergence study (demos/convergence_study.py --bulk): hertz.py's own meshes
-# ("demo": the size grows away from the contact up to 100 h, a 40 a x 20 a block), or a bulk
-# whose error stays below the contact's down to a/80 ("resolved": cells at most a/4 anywhere
-# near, an 80 a x 40 a block; at R = 40, a/80, body-fitted, a finer bulk moves the augmented
-# p(x) error by 0.004 %). With the demo's bulk the far cells make the bodies too stiff (a
-# narrower, higher pressure), which the penalty's compliance hides and the augmented
-# Lagrangian does not: at R = 40, body-fitted, a/20 -> a/80, the augmented error falls from
-# 0.92 to 0.39 % there (rate 0.64), from 0.69 to 0.17 % with the resolved bulk (rate 1.08;
+# ("demo": far cells at most 20 h, a 40 a x 20 a block growing as sqrt(a / h) below a/20:
+# meshes/hertz.py FAR_CELLS, block_growth), or a bulk whose error stays below the contact's at
+# every h ("resolved": cells at most a/4 anywhere near, an 80 a x 40 a block; at R = 40, a/80,
+# body-fitted, a finer bulk moves the augmented p(x) error by 0.004 %). Both give the same
+# figures (R = 40, body-fitted, augmented, a/20 -> a/80: 0.83 -> 0.17 % demo, 0.69 -> 0.17 %
+# resolved), the demo's at a tenth of the dofs at a/20. hertz.py's former bulk (cells up to 100 h,
+# the a/20 block at every h) floored the augmented error at 0.39 % there (rate 0.64;
 # docs/demos/convergence_study.md)
 BULKS = ("resolved", "demo")
 PATHS, ENFORCEMENTS = ("conforming", "cut"), ("penalty", "augmented")
