@@ -12,8 +12,8 @@ monotonically at a fitted rate (least squares, log error vs log h) >= 0.75; agai
 the scene meshes it is reported (Hertz's parabola is 0.4 % off it at R = 10, 0.03 % at R = 40),
 as are the rates of a and p0. Paths: body-fitted (P1 triangles in layers) and cut (Q1 on a graded
 grid). --bulk resolved (default): bodies meshed so that their own error stays below the
-contact's (study.bulk_args); demo: hertz.py's own meshes (their bulk refines with h too, at a
-tenth of the resolved bulk's dofs at a/20: the same figures, docs/demos/convergence_study.md).
+contact's (study.bulk_args); demo: hertz.py's own meshes (their bulk refines below a/20 too:
+the same figures at a/80, far fewer dofs at a/20, docs/demos/convergence_study.md).
 
 Outputs in --out (default results/convergence, replaced atomically when every run is done):
   convergence.json  the case; per run h, dofs, times, a, p0, four errors; per group

@@ -102,7 +102,8 @@ SIZE_OPTIONS = [
     ("--zone", "[1, inf)", None, "half-width of the zone meshed at h, in units of the Hertz a "
      "(default 1.0 with the fast settings of path_defaults, else 1.2)"),
     ("--h-far", "(0, inf)", None,
-     "mesh size far from the contact (default min(R / 2, depth / 2, 20 h))"),
+     "mesh size far from the contact (default min(R / 2, depth / 2, 100 h), times 20 h / a "
+     "below h = a/20)"),
     ("--grading", "(0, inf)", None,
      "size growth away from the zone: slope (body-fitted: default 0.5 with --mesher layers, "
      "0.25 with gmsh) or ratio of neighbouring cells (cut, > 1, default 2)"),
@@ -188,13 +189,22 @@ def demo_sizes(args, hertz_a):
 
 # demos/hertz.py's bulk, chosen so that its error falls with the contact's instead of
 # flooring it (the augmented Lagrangian, which adds no compliance, shows the floor; the penalty's
-# compliance partly cancels it). Far cells at most FAR_CELLS h: at R = 40, a/80, augmented, p(x)
-# 0.383 % with 100 h, 0.222 % with 20 h, 0.210 % with 10 h (154k, 292k dofs against 110k). The
-# block's finite size, O((a / depth)^2) against the half-space, falls like h when the block
-# grows as sqrt(a / h) (`block_growth`): with both, a/20 -> a/80 gives 0.78 -> 0.17 % (rate
-# 1.1) body-fitted and 0.98 -> 0.27 % (0.93) cut, against 0.93 -> 0.38 % and 1.03 -> 0.34 % with
-# 100 h and the a/20 block (docs/demos/convergence_study.md).
-FAR_CELLS = 20
+# compliance partly cancels it), while h = a/20 and coarser keep the fast meshes of
+# `path_defaults`: far cells at most FAR_CELLS h down to a/20, FAR_CELLS h (20 h / a) below
+# (`far_cell_size`), and the block 40 a x 20 a growing as sqrt(a / (20 h)) below a/20
+# (`block_growth`; its finite size is an O((a / depth)^2) error against the half-space). At
+# R = 40, a/80, augmented, body-fitted, p(x): 0.383 % with far cells of 100 h and the a/20
+# block, 0.222 / 0.210 % with 20 h / 10 h, 0.167 % with 20 h and the grown block, 0.177 % with
+# this rule (187k dofs against 110k); a/20 -> a/80 then falls at rate 1.2 body-fitted, 1.0 cut,
+# against 0.64 and 0.81 before (docs/demos/convergence_study.md).
+FAR_CELLS = 100
+
+
+def far_cell_size(hertz_a, h):
+    """The largest cell of the default bulk: FAR_CELLS h down to h = a/20, then shrinking like
+    h^2 (FAR_CELLS h (20 h / a)), so that the far cells' stiffening falls with h (with far
+    cells of a fixed multiple of h it floors the error: 100 h at a/80, 0.38 % against 0.18 %)."""
+    return FAR_CELLS * h * min(1.0, 20.0 * h / hertz_a)
 
 
 def block_growth(hertz_a, h):
@@ -216,7 +226,7 @@ def scene_sizes(p, hertz_a):
     cut = p["discretization"] == "cut"
     zone, band = p["zone"] * hertz_a, demo_band(p, hertz_a)
     # the far field coarsens with h, so that its error falls with h's (fixed h_far: a floor)
-    h_far = p["h_far"] or min(p["R"] / 2, p["depth"] / 2, FAR_CELLS * p["h"])
+    h_far = p["h_far"] or min(p["R"] / 2, p["depth"] / 2, far_cell_size(hertz_a, p["h"]))
     # body-fitted slope 0.5 instead: the same error at a/20 but a floor of 0.55 % from a/40
     growth = p["grading"] or (2.0 if cut else 0.25)
     size = {k: p[k] for k in ("R", "width", "depth", "h")}

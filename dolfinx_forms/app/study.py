@@ -343,13 +343,13 @@ VARIANTS = {  # name -> hertz.py arguments selecting the discretisation
     "q1-cut-aug": ["--discretization", "cut", "--enforcement", "augmented"],
 }
 # the bulk of a convergence study (demos/convergence_study.py --bulk): hertz.py's own meshes
-# ("demo": far cells at most 20 h, a 40 a x 20 a block growing as sqrt(a / h) below a/20:
-# meshes/hertz.py FAR_CELLS, block_growth), or a bulk whose error stays below the contact's at
-# every h ("resolved": cells at most a/4 anywhere near, an 80 a x 40 a block; at R = 40, a/80,
-# body-fitted, a finer bulk moves the augmented p(x) error by 0.004 %). Both give the same
-# figures (R = 40, body-fitted, augmented, a/20 -> a/80: 0.83 -> 0.17 % demo, 0.69 -> 0.17 %
-# resolved), the demo's at a tenth of the dofs at a/20. hertz.py's former bulk (cells up to 100 h,
-# the a/20 block at every h) floored the augmented error at 0.39 % there (rate 0.64;
+# ("demo": far cells of 100 h in a 40 a x 20 a block down to a/20, below that shrinking like h^2
+# in a block growing as sqrt(a / h): meshes/hertz.py far_cell_size, block_growth), or a bulk
+# whose error stays below the contact's at every h ("resolved": cells at most a/4 anywhere near,
+# an 80 a x 40 a block; at R = 40, a/80, body-fitted, a finer bulk moves the augmented p(x) error
+# by 0.004 %). At R = 40, body-fitted, augmented, a/20 -> a/80: 0.92 -> 0.18 % demo (rate 1.22),
+# 0.69 -> 0.17 % resolved (1.08), the demo's at 8.4k dofs at a/20 against 131k. hertz.py's
+# former bulk (100 h and the a/20 block at every h) floored it at 0.39 % (rate 0.64;
 # docs/demos/convergence_study.md)
 BULKS = ("resolved", "demo")
 PATHS, ENFORCEMENTS = ("conforming", "cut"), ("penalty", "augmented")
