@@ -103,7 +103,7 @@ SIZE_OPTIONS = [
      "(default 1.0 with the fast settings of path_defaults, else 1.2)"),
     ("--h-far", "(0, inf)", None,
      "mesh size far from the contact (default min(R / 2, depth / 2, 100 h), times 20 h / a "
-     "below h = a/20)"),
+     "below h = a/20, at least 20 h)"),
     ("--grading", "(0, inf)", None,
      "size growth away from the zone: slope (body-fitted: default 0.5 with --mesher layers, "
      "0.25 with gmsh) or ratio of neighbouring cells (cut, > 1, default 2)"),
@@ -190,21 +190,23 @@ def demo_sizes(args, hertz_a):
 # demos/hertz.py's bulk, chosen so that its error falls with the contact's instead of
 # flooring it (the augmented Lagrangian, which adds no compliance, shows the floor; the penalty's
 # compliance partly cancels it), while h = a/20 and coarser keep the fast meshes of
-# `path_defaults`: far cells at most FAR_CELLS h down to a/20, FAR_CELLS h (20 h / a) below
-# (`far_cell_size`), and the block 40 a x 20 a growing as sqrt(a / (20 h)) below a/20
+# `path_defaults`: far cells at most FAR_CELLS h down to a/20, FAR_CELLS h (20 h / a) below,
+# at least FAR_CELLS_MIN h (`far_cell_size`), and the block 40 a x 20 a growing as sqrt(a / (20 h)) below a/20
 # (`block_growth`; its finite size is an O((a / depth)^2) error against the half-space). At
 # R = 40, a/80, augmented, body-fitted, p(x): 0.383 % with far cells of 100 h and the a/20
 # block, 0.222 / 0.210 % with 20 h / 10 h, 0.167 % with 20 h and the grown block, 0.177 % with
 # this rule (187k dofs against 110k); a/20 -> a/80 then falls at rate 1.2 body-fitted, 1.0 cut,
 # against 0.64 and 0.81 before (docs/demos/convergence_study.md).
-FAR_CELLS = 100
+FAR_CELLS, FAR_CELLS_MIN = 100, 20
 
 
 def far_cell_size(hertz_a, h):
     """The largest cell of the default bulk: FAR_CELLS h down to h = a/20, then shrinking like
     h^2 (FAR_CELLS h (20 h / a)), so that the far cells' stiffening falls with h (with far
-    cells of a fixed multiple of h it floors the error: 100 h at a/80, 0.38 % against 0.18 %)."""
-    return FAR_CELLS * h * min(1.0, 20.0 * h / hertz_a)
+    cells of a fixed multiple of h it floors the error: 100 h at a/80, 0.38 % against 0.18 %),
+    down to FAR_CELLS_MIN h (from a/100: at a/80, 20 h and 10 h differ by 0.012 %, while the
+    bulk's cells would grow like h^-4)."""
+    return max(FAR_CELLS_MIN, FAR_CELLS * min(1.0, 20.0 * h / hertz_a)) * h
 
 
 def block_growth(hertz_a, h):

@@ -67,8 +67,8 @@ def test_defaults_are_the_fast_settings(tmp_path_factory):
 
 def test_default_bulk_follows_h():
     """hertz.py's default bulk refines below h = a/20 and is the fast one above: far cells at
-    most 100 h (or R/2, depth/2), times 20 h / a below a/20, and the block 40 a x 20 a growing
-    as sqrt(a / (20 h)) below a/20; sizes given on the command line win."""
+    most 100 h (or R/2, depth/2), times 20 h / a below a/20 but at least 20 h, and the block
+    40 a x 20 a growing as sqrt(a / (20 h)) below a/20; sizes given on the command line win."""
     from types import SimpleNamespace
 
     from meshes.hertz import demo_sizes, scene_sizes
@@ -76,7 +76,7 @@ def test_default_bulk_follows_h():
     a = 2.0
     base = dict(mesher="layers", discretization="conforming", grading=0.5, quads=False,
                 width=None, depth=None, zone=1.0, R=40.0)  # fmt: skip
-    for k, grow, far in ((10, 1.0, 20.0), (20, 1.0, 10.0), (80, 2.0, 0.625), (320, 4.0, 0.0390625)):
+    for k, grow, far in ((10, 1.0, 20.0), (20, 1.0, 10.0), (80, 2.0, 0.625), (320, 4.0, 0.125)):
         args = SimpleNamespace(**base, h=a / k)
         width, depth, h = demo_sizes(args, a)
         assert (width, depth, h) == pytest.approx((40 * a * grow, 20 * a * grow, a / k))
