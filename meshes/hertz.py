@@ -191,12 +191,12 @@ def demo_sizes(args, hertz_a):
 # flooring it (the augmented Lagrangian, which adds no compliance, shows the floor; the penalty's
 # compliance partly cancels it), while h = a/20 and coarser keep the fast meshes of
 # `path_defaults`: far cells at most FAR_CELLS h down to a/20, FAR_CELLS h (20 h / a) below,
-# at least FAR_CELLS_MIN h (`far_cell_size`), and the block 40 a x 20 a growing as sqrt(a / (20 h)) below a/20
-# (`block_growth`; its finite size is an O((a / depth)^2) error against the half-space). At
-# R = 40, a/80, augmented, body-fitted, p(x): 0.383 % with far cells of 100 h and the a/20
-# block, 0.222 / 0.210 % with 20 h / 10 h, 0.167 % with 20 h and the grown block, 0.177 % with
-# this rule (187k dofs against 110k); a/20 -> a/80 then falls at rate 1.2 body-fitted, 1.0 cut,
-# against 0.64 and 0.81 before (docs/demos/convergence_study.md).
+# at least FAR_CELLS_MIN h (`far_cell_size`), and the block 40 a x 20 a growing as
+# sqrt(a / (20 h)) below a/20 (`block_growth`; its finite size is an O((a / depth)^2) error
+# against the half-space). At R = 40, a/80, augmented, body-fitted, p(x): 0.383 % with far
+# cells of 100 h and the a/20 block, 0.222 / 0.210 % with 20 h / 10 h, 0.167 % with 20 h and the
+# grown block, 0.177 % with this rule (187k dofs against 110k); a/20 -> a/80 then falls at rate
+# 1.22 body-fitted, 0.95 cut, against 0.64 and 0.81 before (docs/demos/convergence_study.md).
 FAR_CELLS, FAR_CELLS_MIN = 100, 20
 
 
