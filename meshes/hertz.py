@@ -205,7 +205,8 @@ def far_cell_size(hertz_a, h):
     h^2 (FAR_CELLS h (20 h / a)), so that the far cells' stiffening falls with h (with far
     cells of a fixed multiple of h it floors the error: 100 h at a/80, 0.38 % against 0.18 %),
     down to FAR_CELLS_MIN h (from a/100: at a/80, 20 h and 10 h differ by 0.012 %, while the
-    bulk's cells would grow like h^-4)."""
+    far cells' number, the block's area ~ 1/h over their size squared, would grow like h^-5
+    instead of h^-3)."""
     return max(FAR_CELLS_MIN, FAR_CELLS * min(1.0, 20.0 * h / hertz_a)) * h
 
 
