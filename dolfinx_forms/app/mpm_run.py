@@ -247,6 +247,8 @@ class Steps:
             cutbacks=int(sum(r["cutbacks"] for r in self.records)),
             # sub-steps per step: a failed step is done again in halves (ImplicitMPM.step)
             substeps=[r.get("substeps", 1) for r in self.records],
+            # sub-steps per step whose Newton started from the last increment (increment.py)
+            predicted=[r.get("predicted", 0) for r in self.records],
             factorisations=[r["factorisations"] for r in self.records],  # per step
             coupling_rebuilds=[r["coupling_rebuilds"] for r in self.records],  # per step
             warnings=[f"step {k}: {w}" for w, k in self.checks.items()],

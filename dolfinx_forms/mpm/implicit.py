@@ -16,7 +16,9 @@ rigid level sets (`obstacles.py`). One load step:
 3. the friction history is carried from the previous step's contact points to the new ones
    (`transfer_friction`);
 4. Newton on the displacement increment du of the step (`ContactProblem`, penalty contact and
-   Coulomb friction, obstacles' motion and Dirichlet increments ramped with lam, cut-back);
+   Coulomb friction, obstacles' motion and Dirichlet increments ramped with lam, cut-back),
+   started from the last step's increment where that lowers the first residual (quasi-static,
+   `extrapolate`: `increment.py`);
 5. the material points move and update stress and volume (`material_points.update`);
 6. du is extended off each body along the normal (eq 20) and the level set advected by it
    (eq 19, HJ-WENO5 + TVD-RK3), reinitialised when |grad phi| drifts; obstacles move.
@@ -51,7 +53,7 @@ from dolfinx_forms.fem.boundary import Load
 from dolfinx_forms.fem import jit_memo
 from dolfinx_forms.fem.cut import grid_cells, material_window
 from dolfinx_forms.fem.laws import as_law, law_key
-from dolfinx_forms.mpm import evolution, records
+from dolfinx_forms.mpm import evolution, increment, records
 from dolfinx_forms.mpm import finite_strain as fs
 from dolfinx_forms.solvers.newton import ContactSolverError
 from dolfinx_forms.solvers.options import options
@@ -75,7 +77,7 @@ MAX_BAND_GROWTH = 4  # doublings of the contact band within one step (16 times t
 MAX_SPLITS = 3
 # step-record counters that add up over a step's sub-steps (the rest: the last sub-step's)
 _SUMMED = ("newton_iterations", "cutbacks", "factorisations", "coupling_rebuilds",
-           "mls_widened", "mls_F_nearest", "wall_s")  # fmt: skip
+           "mls_widened", "mls_F_nearest", "wall_s", "predicted")  # fmt: skip
 
 
 def equilibrium_error(record):
@@ -121,7 +123,9 @@ class ImplicitMPM:
     `RigidObstacle`s with their motion per step; dirichlet: `Dirichlet` conditions whose values
     are the increments of one step (at lam = 1); reinit_drift: reinitialise a level set when
     max | |grad phi| - 1 | within 3 h of its zero contour exceeds it; levelset_update:
-    "advection" (eq 19) or "reference-map" (the points' map, `evolution.py`). Other keywords go to
+    "advection" (eq 19) or "reference-map" (the points' map, `evolution.py`); extrapolate:
+    quasi-static steps start Newton from the last step's increment per unit of step where that
+    lowers the first residual (`increment.py`; False: from du = 0). Other keywords go to
     `ContactProblem` (mu, eps0, band, newton, petsc_options, ghost_penalty, ...)."""
 
     def __init__(
@@ -137,6 +141,7 @@ class ImplicitMPM:
         levelset_update=evolution.LEVELSET_UPDATES[0],
         dynamics=None,
         max_splits=MAX_SPLITS,
+        extrapolate=True,
         timer=None,
         log=print,
         **problem_kw,
@@ -184,6 +189,15 @@ class ImplicitMPM:
             raise ValueError(f"ImplicitMPM: max_splits must be an integer in [0, 10], got "
                              f"{max_splits!r}")  # fmt: skip
         self.max_splits = max_splits  # halvings of a failed quasi-static step (`step`)
+        # quasi-static: Newton starts from the last step's increment where that lowers the
+        # first residual (`increment.py`); the Increment of the last accepted (sub-)step
+        self.extrapolate = bool(extrapolate)
+        self.increment = None
+        self.grid_key = (
+            (self.xlines[0], self.ylines[0]),
+            self.h,
+            (len(self.xlines), len(self.ylines)),
+        )
         self.timer = timer
         self.threads = worker_threads(comm)
         self.log = log if comm.rank == 0 else (lambda *a, **k: None)
@@ -220,6 +234,7 @@ class ImplicitMPM:
             friction={k: tuple(a.copy() for a in v) for k, v in self.friction.items()},
             step_count=self.step_count,
             time=None if self.dynamics is None else self.dynamics.time,
+            increment=self.increment,  # immutable: shared
         )
 
     def restore(self, snap):
@@ -231,6 +246,7 @@ class ImplicitMPM:
             ob.set_state(s)
         self.friction = {k: tuple(a.copy() for a in v) for k, v in snap["friction"].items()}
         self.step_count = snap["step_count"]
+        self.increment = snap["increment"]
         if self.dynamics is not None:
             self.dynamics.time = snap["time"]
 
@@ -352,9 +368,14 @@ class ImplicitMPM:
                 )
             )
         kw = dict(self.problem_kw, band=self.band, band_growth=0)  # `step` grows it
+        kw.setdefault("short_lived", True)  # a mesh per step: MUMPS's cheaper analysis
         kw.setdefault("pair_grid_origin", (self.xlines[0], self.ylines[0]))
         if ranks is not None:
             kw["contact_rank"] = ranks
+        extrapolate = self.extrapolate and self.dynamics is None
+        predictor = None
+        if extrapolate and self.increment is not None:
+            predictor = increment.predictor(self.increment, self.grid_key)
         problem = ContactProblem(
             scene,
             laws,
@@ -363,6 +384,7 @@ class ImplicitMPM:
             obstacles=self.obstacles,
             timer=self.timer,
             log=self.log,
+            predictor=predictor,
             **options(**kw),
         )
         if self.points is None:
@@ -395,6 +417,8 @@ class ImplicitMPM:
                     mp.update(pts, du, grad, self.C[b.tag])
                 outside += n_out
                 moved.append(du)
+            if extrapolate:
+                self.increment = increment.record(problem, self.grid_key, fraction)
             if self.step_count == 0:  # the whole first step's, over its sub-steps
                 first = self._substep == 0
                 self.first_step_du = moved if first else [*map(np.add, self.first_step_du, moved)]
@@ -417,6 +441,7 @@ class ImplicitMPM:
             # |R| of every Newton iteration of the accepted solve (a cut-back's are dropped)
             residuals=[float(r) for s in problem.steps for r in s.residuals],
             cutbacks=int(sum(s.cutback for s in problem.steps)),
+            predicted=int(problem.guess_taken),  # `increment.py`
             # sparse factorisations of the accepted solve (each step builds its own problem)
             factorisations=int(problem.factorisations),
             coupling_rebuilds=int(problem.coupling_rebuilds),  # SolverOptions.coupling_gap

@@ -101,26 +101,44 @@ def tolerance(problem, r0):
     return max(opts.rtol * r0, opts.ftol * problem.force_scale, opts.atol)
 
 
-def newton(problem, lam, r_ref=0.0, early=0.0):
+def newton(problem, lam, r_ref=0.0, early=0.0, guess=None):
     """Newton at load level lam from the committed state of `problem` (a ContactProblem).
     r_ref: a residual that the relative test may also refer to (the step's first residual, for
     the later solves of an augmented Lagrangian loop, which start near the answer). early: stop
     once the residual is below early times the first (an inexact solve of the Uzawa loop).
-    Returns (ok, residuals, why)."""
+    guess(problem, lam): adds a predicted increment to u (`load_steps`); Newton starts from it
+    only if it lowers the first residual (then without the stick predictor, which would read
+    the predicted slip as stuck), and the relative test still refers to the residual of the
+    committed state. Returns (ok, residuals, why)."""
     opts = problem.newton
     problem.set_bc_values(lam)
     residuals, seen = [], {}
     r0 = None
+    r_zero, u_start = None, None  # with a guess: the committed state's residual and u
+    if guess is not None and r_ref == 0:  # both residuals as the first iteration's, unstuck
+        r_zero = problem.residual(lam, predictor=problem.predictor_gap > 0)
+        u_start = problem.u.x.array.copy()
+        guess(problem, lam)
+        problem.set_bc_values(lam)
     # the later solves of an augmented loop start from a converged state (no predictor) and
     # take at least one iteration: the multipliers' change is below the step's tolerance
     later = r_ref > 0
     r_base, sig_base, backtracks = None, None, 0  # where the last Newton step started
     for it in range(opts.max_iterations + 1):
         predictor = it == 0 and not later and problem.predictor_gap > 0
+        guessed = it == 0 and r_zero is not None
         stick = it == 0 and not later and opts.stick_predictor and problem.contact.mu > 0
         # J is assembled once its key is known unless J holds the last keyed tangent (`_keep`)
         lazy = problem.J_key is not None and not (predictor or stick or problem.bulk.nonlinear)
-        r = problem.residual(lam, with_tangent=not lazy, predictor=predictor, stick=stick)
+        r = problem.residual(
+            lam, with_tangent=not lazy, predictor=predictor, stick=stick and not guessed
+        )
+        if guessed:
+            problem.guess_taken = bool(r < r_zero)
+            if not problem.guess_taken:  # no better than the committed state: start there
+                problem.u.x.array[:] = u_start
+                problem.u.x.scatter_forward()
+                r = problem.residual(lam, with_tangent=not lazy, predictor=predictor, stick=stick)
         residuals.append(r)
         if not np.isfinite(r):
             # a step past what the state allows (finite strain: det F <= 0 beyond it) is
@@ -141,7 +159,7 @@ def newton(problem, lam, r_ref=0.0, early=0.0):
             return False, residuals, f"non-finite residual at iteration {it} ({why})"
 
         if r0 is None:
-            r0 = max(r, r_ref)
+            r0 = max(r, r_ref, r_zero or 0.0)
         # relative to the step's first residual, with a round-off floor relative to the
         # problem's force scale: no absolute floor that would accept the initial guess of a
         # problem with small forces (E = 1e-12 converges like E = 1)
@@ -362,19 +380,18 @@ def _augmented_loop(problem, lam, residuals, depth=20):
 def load_steps(problem, num_steps=1, lam_end=1.0, label="step", initial_guess=None):
     """Ramp the load level of `problem` from its committed value to lam_end in num_steps
     equal steps, with cut-back; one progress line per accepted step. initial_guess(problem,
-    lam) may set u before the first Newton iteration of a step. Raises ContactSolverError."""
+    lam) may add a predicted increment to u before the first Newton iteration of a step, taken
+    where it lowers the first residual (`newton`). Raises ContactSolverError."""
     dlam = (lam_end - problem.lam) / num_steps
     cuts = 0
     while problem.lam < lam_end - 1e-14 * max(1.0, abs(lam_end)):
         target = min(problem.lam + dlam, lam_end)
         if problem.control is not None:
             problem.control.predict(target)
-        if initial_guess is not None:
-            initial_guess(problem, target)
         t0 = time.perf_counter()
         problem.contact.start_step()
         early = problem.newton.al_first if problem.contact.augmented else 0.0
-        ok, residuals, why = newton(problem, target, early=early)
+        ok, residuals, why = newton(problem, target, early=early, guess=initial_guess)
         augmentations = 0
         if ok and problem.contact.augmented:
             ok, augmentations, why = augmented_loop(problem, target, residuals)

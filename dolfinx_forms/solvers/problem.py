@@ -51,7 +51,10 @@ class ContactProblem:
     ContactOptions, FemOptions, SolverOptions; `**options(mu=..., degree=...)` sorts flat
     keywords into them). A scene with `cut` data integrates over the inside part of cut
     cells (`fem.cut.CutIntegration`) with a ghost penalty. timer: a `io.results.PhaseTimer`
-    (or None); log: where the Newton lines go (rank 0).
+    (or None); log: where the Newton lines go (rank 0). predictor(problem) -> guess or None:
+    guess(problem, lam) adds a predicted increment to u, which Newton starts from where it
+    lowers the first residual (`solve`, `newton.newton`); the law points it closes join the
+    contact tangent's sparsity with those near contact (`_coupling_points`).
     """
 
     def __init__(
@@ -68,6 +71,7 @@ class ContactProblem:
         solver=None,
         timer=None,
         log=print,
+        predictor=None,
     ):
         c = contact if contact is not None else ContactOptions()
         fo = fem if fem is not None else FemOptions()
@@ -105,8 +109,11 @@ class ContactProblem:
             )
         self.coupling_gap = None if so.coupling_gap is None else float(so.coupling_gap) * h
         self.coupling_rebuilds = 0  # matrices built again for a point outside the sparsity
+        self.short_lived = bool(so.short_lived)  # `linear.Factorised`'s ordering
         picked = linear.pick(self, so.linear_solver, so.petsc_options)
         self._coupled = picked[0] == "factorised"
+        self.lam = 0.0
+        self.guess = None if predictor is None else predictor(self)
         self.coupled = self._coupling_points()
         with self.phase("assembly"):
             self._matrices(fo.ghost_penalty)
@@ -115,7 +122,7 @@ class ContactProblem:
             self.linear = linear.choose(self, so.linear_solver, so.petsc_options, picked)
         self.control = None  # force_control.ForceControl while a force-controlled stage runs
         self.u_committed = self.u.x.array.copy()
-        self.lam = 0.0
+        self.guess_taken = False  # newton: whether the last solve started from its guess
         self.steps = []
 
     def _bulk(self, fo, dirichlet, tractions, loads):
@@ -162,13 +169,24 @@ class ContactProblem:
     def _coupling_points(self):
         """Per pair, a mask of the law points whose tangent blocks the sparsity holds: those
         with a gap below the larger of coupling_gap and predictor_gap before the step's
-        deformation (`ContactSet.law_gaps0`); None (every law point) without a coupling_gap or
-        where the linear solver is not `Factorised`."""
+        deformation (`ContactSet.law_gaps0`) or at the end of the predicted increment
+        (`guess`); None (every law point) without a coupling_gap or where the linear solver is
+        not `Factorised`."""
         if self.coupling_gap is None or not self._coupled:
             return None
         # the predictor's first tangent holds the touching points too
         gap = max(self.coupling_gap, self.predictor_gap)
-        return [self.contact.law_gaps0(k) < gap for k in range(len(self.pairs))]
+        coupled = [self.contact.law_gaps0(k) < gap for k in range(len(self.pairs))]
+        if self.guess is not None:  # else the first iteration's tangent grows the sparsity
+            with self.phase("contact"):
+                self.guess(self, 1.0)
+                self.contact.set_load(1.0)
+                self.contact.assemble(self.u.x.array, self._rc.x.array)
+                coupled = [c | (s["law_g_n"] < gap) for c, s in zip(coupled, self.contact.last)]
+                self.u.x.array[:] = 0.0
+                self._rc.x.array[:] = 0.0
+                self.contact.last = [None] * len(self.pairs)
+        return coupled
 
     def _outside_coupling(self):
         """After a contact assembly into J: per pair, the law points that put a tangent block
@@ -396,8 +414,9 @@ class ContactProblem:
 
     def solve(self, num_steps=1, lam_end=1.0, label="step", initial_guess=None):
         """Ramp the load from the committed level to lam_end in num_steps equal steps, with
-        cut-back (`newton.load_steps`). Raises ContactSolverError."""
-        load_steps(self, num_steps, lam_end, label, initial_guess)
+        cut-back (`newton.load_steps`; initial_guess: that of `predictor` unless given).
+        Raises ContactSolverError."""
+        load_steps(self, num_steps, lam_end, label, initial_guess or self.guess)
 
     # ------------------------------------------------------------------ the band
     def band_reached(self):

@@ -167,7 +167,7 @@ def test_brazilian_disc_coarse():
 
 
 def test_rejected_step_is_invisible():
-    """A step that fails (Newton capped at one iteration, no cut-back) restores everything:
+    """A step that fails (Newton allowed no iteration, no cut-back) restores everything:
     the re-run step is bitwise identical to that of a run that never failed."""
     ref = disc_sim(steps=3)
     for _ in range(3):
@@ -176,7 +176,7 @@ def test_rejected_step_is_invisible():
     sim.step()
     sim.step()
     good = sim.problem_kw.get("newton")
-    sim.problem_kw["newton"] = NewtonOptions(max_iterations=1, max_cutbacks=0)
+    sim.problem_kw["newton"] = NewtonOptions(max_iterations=0, max_cutbacks=0)
     with pytest.raises(ContactSolverError):
         sim.step()
     sim.problem_kw["newton"] = good
@@ -210,7 +210,7 @@ def test_each_step_frees_the_problem_it_replaces(monkeypatch):
     cur = sim.problem
     destroyed, destroy = [], ContactProblem.destroy
     monkeypatch.setattr(ContactProblem, "destroy", lambda p: (destroyed.append(p), destroy(p)))
-    sim.problem_kw["newton"] = NewtonOptions(max_iterations=1, max_cutbacks=0)
+    sim.problem_kw["newton"] = NewtonOptions(max_iterations=0, max_cutbacks=0)
     with pytest.raises(ContactSolverError):
         sim.step()
     # the whole step and its halves down to 2^-max_splits: one problem each, all freed
@@ -615,3 +615,73 @@ def test_a_step_failing_at_every_split_names_the_depth_and_is_undone(monkeypatch
         whole.step()
     with pytest.raises(ValueError, match="max_splits"):
         _disc(0.02, 2, max_splits=-1)
+
+
+def test_the_last_increment_predicts_the_next_step():
+    """Newton starts each step from the last step's increment (`mpm/increment.py`) where that
+    lowers the first residual: the same steps to Newton's tolerance in fewer iterations. A
+    reversed increment raises the first residual and is not taken: the iterations of a start
+    from du = 0."""
+    runs = {}
+    for extrapolate in (False, True):
+        sim = disc_sim(steps=6, extrapolate=extrapolate)
+        runs[extrapolate] = (sim, [sim.step() for _ in range(6)])
+    (off, a), (on, b) = runs[False], runs[True]
+    assert [r["predicted"] for r in a] == [0] * 6
+    assert sum(r["predicted"] for r in b) >= 4 and b[0]["predicted"] == 0
+    assert sum(r["newton_iterations"] for r in b) < sum(r["newton_iterations"] for r in a)
+    for ra, rb in zip(a, b):
+        for name, f in ra["obstacles"].items():
+            assert abs(f["fy"]) > 100  # loaded
+            assert rb["obstacles"][name]["fy"] == pytest.approx(f["fy"], rel=1e-8)
+    assert np.abs(on.points[1].x - off.points[1].x).max() <= 1e-10 * 10.0
+    # the guess a step takes is the last increment per unit of step, node by node
+    inc = on.increment
+    assert np.all(np.diff(inc.keys) > 0) and len(inc.keys) == on.problem.num_dofs // 2
+    reverse = type(inc)(inc.keys, -inc.rate)
+    on.increment, off.increment = reverse, None
+    off.extrapolate = False
+    r_rev, r_off = on.step(), off.step()
+    assert r_rev["predicted"] == 0
+    assert r_rev["newton_iterations"] == r_off["newton_iterations"]
+
+
+def test_increment_keys_and_predictor_round_trip():
+    """Each local node has its own (body, grid node) key, and the predictor of a recorded
+    increment puts the recorded u back at lam = fraction."""
+    from dolfinx_forms.mpm import increment
+
+    sim = disc_sim(steps=2)
+    sim.step()
+    p = sim.problem
+    keys = increment.node_keys(p, sim.grid_key)
+    assert len(np.unique(keys)) == len(keys) == len(p.u.x.array) // 2
+    u = p.u.x.array.copy()
+    assert np.abs(u).max() > 1e-3
+    inc = increment.record(p, sim.grid_key, 0.5)
+    p.u.x.array[:] = 0.0
+    lam = p.lam
+    p.lam = 0.0
+    increment.predictor(inc, sim.grid_key)(p)(p, 0.5)
+    p.lam = lam
+    assert np.allclose(p.u.x.array, u, rtol=1e-15, atol=0.0)
+
+
+def test_an_mpm_step_factorises_with_the_short_lived_ordering():
+    """An MPM step's problem serves one load step: `Factorised` has MUMPS order it by AMD
+    (ICNTL(7) = 0, INFOG(7) the ordering used) for that analysis only; the option does not
+    stay in PETSc's options for the problems that follow."""
+    from petsc4py import PETSc
+
+    from dolfinx_forms.solvers.linear import SHORT_LIVED_ORDERING
+
+    sim = disc_sim(steps=2, linear_solver="factorised")
+    sim.step()
+    lin = sim.problem.linear
+    assert lin.name == "factorised" and lin.ordering == SHORT_LIVED_ORDERING == 0
+    assert lin.ksp.getPC().getFactorMatrix().getMumpsInfog(7) == SHORT_LIVED_ORDERING
+    assert not PETSc.Options().hasName("ils_mat_mumps_icntl_7")
+    user = disc_sim(steps=2, linear_solver="factorised", petsc_options={"mat_mumps_icntl_7": 4})
+    user.step()
+    assert user.problem.linear.ordering is None  # the user's choice stands
+    assert user.problem.linear.ksp.getPC().getFactorMatrix().getMumpsInfog(7) == 4  # PORD
