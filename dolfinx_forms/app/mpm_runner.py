@@ -264,6 +264,7 @@ def make_simulation(spec, comm, timer=None, log=print):
         dirichlet=list(dirichlet.values()),
         reinit_drift=s["reinit_drift"],
         levelset_update=s["levelset_update"],
+        extrapolate=s["extrapolate"],
         dynamics=dyn,
         timer=timer,
         log=log,

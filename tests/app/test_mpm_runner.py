@@ -144,6 +144,7 @@ BAD = [  # (override, the key the message names, a word of the message)
     ("dynamics={dt=0.1, damping=1.0}", "dynamics.damping", "unknown"),
     ("bodies[0].rho=-1.0", "bodies[0].rho", "> 0"),
     ("solver.levelset_update='weno'", "solver.levelset_update", "reference-map"),
+    ("solver.extrapolate=1", "solver.extrapolate", "true"),
 ]  # fmt: skip
 
 
@@ -158,7 +159,8 @@ def test_bad_description_names_the_key(override, key, word):
 def test_base_description_is_valid():
     spec = load(BASE)
     assert spec["solver"]["band"] is None and spec["stages"][0]["move"]["floor"]["rotation"] == 0
-    assert spec["solver"]["levelset_update"] == "advection"
+    assert spec["solver"]["levelset_update"] == "advection" and spec["solver"]["extrapolate"]
+    assert not load(BASE, ["solver.extrapolate=false"])["solver"]["extrapolate"]
     assert load(BASE, ["solver.levelset_update='reference-map'"])["solver"]["levelset_update"] == (
         "reference-map"
     )
@@ -190,10 +192,16 @@ def test_finite_strain_laws_and_the_augmented_lagrangian_from_a_file(tmp_path):
     """A description's finite-strain laws (neo-hookean, j2) and solver.enforcement =
     "augmented" reach the simulation: the nine-discs scene with its first disc's law replaced
     runs with each; j2 is refused on the single-step path."""
-    for law, enforcement in (("{type='j2', E=1.0e5, nu=0.3, yield_stress=200.0}", "penalty"),
-                             ("{type='neo-hookean', E=1.0e5, nu=0.3}", "augmented")):
-        sets = ["checks=[]", f"bodies[0].law={law}", f"solver.enforcement='{enforcement}'",
-                "solver.eps0=0.01"]
+    for law, enforcement in (
+        ("{type='j2', E=1.0e5, nu=0.3, yield_stress=200.0}", "penalty"),
+        ("{type='neo-hookean', E=1.0e5, nu=0.3}", "augmented"),
+    ):
+        sets = [
+            "checks=[]",
+            f"bodies[0].law={law}",
+            f"solver.enforcement='{enforcement}'",
+            "solver.eps0=0.01",
+        ]
         out = tmp_path / enforcement
         r = run(["-m", "dolfinx_forms", "run", SCENES / "nine_discs.toml",
                  *[a for s in sets for a in ("--set", s)], "--out", out], tmp_path)  # fmt: skip
@@ -249,3 +257,21 @@ def test_dynamics_from_a_file_gives_the_bouncing_disc(tmp_path):
         assert np.abs(u).max() > 0 and np.all(np.abs(u - v) <= 1e-8 * np.abs(u).max()), x
     m = json.load(open(tmp_path / "scene" / "metrics.json"))["results"]
     assert m["time_final"] == pytest.approx(0.6) and m["equilibrium_rel_max"] is None
+
+
+def test_extrapolate_from_a_file(tmp_path):
+    """`solver.extrapolate` reaches ImplicitMPM: the Brazilian disc's steps start from the last
+    increment by default (metrics.json `predicted` per step), from du = 0 with false, and the
+    records agree to Newton's tolerance."""
+    sets = ["stages[0].steps=3", "grid.h=0.5", "checks=[]"]
+    outs = {}
+    for extrapolate in ("true", "false"):
+        args = [a for s in [*sets, f"solver.extrapolate={extrapolate}"] for a in ("--set", s)]
+        outs[extrapolate] = out = tmp_path / extrapolate
+        r = run(["-m", "dolfinx_forms", "run", SCENES / "brazilian_disc.toml", *args,
+                 "--out", out], tmp_path)  # fmt: skip
+        assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    on, off = (json.loads((outs[k] / "metrics.json").read_text())["solver"] for k in outs)
+    assert off["predicted"] == [0, 0, 0] and on["predicted"][0] == 0 and sum(on["predicted"]) >= 1
+    assert sum(on["newton_iterations"]) < sum(off["newton_iterations"])
+    assert_same_records(outs["false"], outs["true"], 1e-8)
