@@ -49,9 +49,12 @@ DEFAULT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver
 SHORT_LIVED_ORDERING = 0  # AMD
 # a symmetric bulk or Schur complement: |A - A^T| <= this * |A| (round-off of the assembly)
 SYMMETRY_RTOL = 1e-12
-# Condensed: the break-even of S^-1 per Newton iteration against LU's sparse factorisation
-# per step (Brazilian disc, 5 Newton iterations a step) is ~18
-INVERT_COST = 15.0
+# Condensed: S^-1 per Newton iteration against LU's sparse factorisation per step (after the
+# LDL^T one). At 5 Newton iterations a step the break-even was ~18; since a step starts from
+# the last increment (mpm/increment.py) the Brazilian disc takes 2.26, and at 40 its steps with
+# m = 316-336 (n = 16.4k) invert too: 50 instead of 63 sparse factorisations, the solve phase
+# 4.1-4.7 s instead of 5.1-5.7 over the 50 steps (two interleaved pairs), steps.csv to 6e-15
+INVERT_COST = 40.0
 MAX_CONDENSED = 6000  # the dense m x m blocks (3 of them) stay below ~1 GB
 # "auto" condenses only where m^3 <= defaults.TUNING.condensed_cost n^1.5: a Newton iteration
 # costs a dense m x m update (~m^3) instead of a sparse factorisation (~n^1.5 in 2D)
@@ -240,7 +243,7 @@ class Condensed:
         symmetric = _symmetric(problem.K)
         # a non-symmetric S (friction) on the LDL^T factor is inverted at each update (~4-7x
         # a dense LU, measured at m = 250-2000): that pays against LU's sparse factorisation
-        # (~1.6x LDL^T's; Brazilian disc, m ~ 260, n = 16.4k) while m^3 <= INVERT_COST n^1.5
+        # (~1.6x LDL^T's; Brazilian disc, m ~ 240-340, n = 16.4k) while m^3 <= INVERT_COST n^1.5
         n = problem.K.getSize()[0]
         self.invert = len(dofs) ** 3 <= INVERT_COST * n**1.5
         self.num_dofs = len(dofs)
