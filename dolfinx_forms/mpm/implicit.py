@@ -272,7 +272,7 @@ class ImplicitMPM:
         kept = self.problem, self.scene, self._key
         self._substep, self._made = 0, []  # the problems of the converged sub-steps
         try:
-            records_ = self._advance(1.0, 0)
+            records_ = self._advance(1.0, 0, snap)
         except Exception:
             self.restore(snap)
             for p in self._made:
@@ -295,21 +295,24 @@ class ImplicitMPM:
         ramped = all(callable(d.value) or float(d.value) == 0.0 for d in self.dirichlet)
         return self.dynamics is None and ramped
 
-    def _advance(self, fraction, depth):
-        """The records of `fraction` of the step, split in halves while it fails (`step`)."""
+    def _advance(self, fraction, depth, snap=None):
+        """The records of `fraction` of the step, split in halves while it fails (`step`).
+        snap: a snapshot of the present state, if the caller has one (restore copies from a
+        snapshot, so one serves every attempt from that state: 0.5 s a copy at 400 grains)."""
         try:
-            return [self._band_step(fraction)]
+            return [self._band_step(fraction, snap)]
         except (ContactSolverError, RuntimeError) as e:
             if depth >= self.max_splits or not self._splittable():
                 if depth == 0:
                     raise
                 raise ContactSolverError(f"{e} (at 1/{2**depth} of the step)") from e
             self.log(f"{e}; done again in two halves")
-        return self._advance(fraction / 2, depth + 1) + self._advance(fraction / 2, depth + 1)
+        first = self._advance(fraction / 2, depth + 1, snap)  # restored to snap: its state
+        return first + self._advance(fraction / 2, depth + 1)
 
-    def _band_step(self, fraction):
+    def _band_step(self, fraction, snap=None):
         """`fraction` of the step, the band doubled while active points reach its edge."""
-        snap = self.snapshot()
+        snap = snap or self.snapshot()
         for attempt in range(MAX_BAND_GROWTH + 1):
             try:
                 record = self._step(fraction)
