@@ -620,8 +620,7 @@ def test_a_step_failing_at_every_split_names_the_depth_and_is_undone(monkeypatch
 def test_the_last_increment_predicts_the_next_step():
     """Newton starts each step from the last step's increment (`mpm/increment.py`) where that
     lowers the first residual: the same steps to Newton's tolerance in fewer iterations. A
-    reversed increment raises the first residual and is not taken: the iterations of a start
-    from du = 0."""
+    reversed increment raises the first residual and is not taken: Newton starts from du = 0."""
     runs = {}
     for extrapolate in (False, True):
         sim = disc_sim(steps=6, extrapolate=extrapolate)
@@ -643,7 +642,9 @@ def test_the_last_increment_predicts_the_next_step():
     off.extrapolate = False
     r_rev, r_off = on.step(), off.step()
     assert r_rev["predicted"] == 0
-    assert r_rev["newton_iterations"] == r_off["newton_iterations"]
+    # started from du = 0: the first residual of the run without a guess (the two states agree
+    # to Newton's tolerance, not bitwise: iteration counts could differ by a round-off flip)
+    assert r_rev["residuals"][0] == pytest.approx(r_off["residuals"][0], rel=1e-6)
 
 
 def test_increment_keys_and_predictor_round_trip():
