@@ -3,11 +3,13 @@
 Files (the contract of docs/contract.md, "Multi-step and multi-body outputs"):
 `steps.csv` (the demo's columns), `contacts.csv` (step, body_i, body_j, x, y, normal_force,
 tangential_force, active_length, stick_fraction), `bodies.csv` (step, body, fx, fy, moment,
-area_levelset, volume_points), and two XDMF time series that ParaView opens:
-`material_points.xdmf` (the points at their current positions with stress, volume and
-displacement since the start) and `levelsets.xdmf` (the background grid with each body's level
-set and extended step displacement). Each series keeps its arrays in one HDF5 file beside the
-.xdmf (`Series`), one frame every `series_every` steps.
+area_levelset, volume_points), and XDMF time series that ParaView opens:
+`material_points_<body>.xdmf` (the points at their current positions with stress, volume and
+displacement since the start; beyond SERIES_PER_BODY_MAX bodies one `material_points.xdmf` with
+the body's index) and `levelsets.xdmf` (the background grid with the bodies' combined level set,
+the body it belongs to and its extended step displacement, and up to SERIES_PER_BODY_MAX bodies
+each body's own). Each series keeps its arrays in one HDF5 file beside the .xdmf (`Series`),
+one frame every `series_every` steps.
 
 `Steps` is the step loop of a multi-step demo inside the run skeleton every demo uses
 (`demo.Run`): records, warnings, series frames, the metrics blocks and the step files.
@@ -110,20 +112,43 @@ class Series:
         )
 
 
+# up to this many bodies each has its own point series and level-set fields; beyond, one point
+# series and the combined fields only (per-body whole-grid fields grow as bodies x grid)
+SERIES_PER_BODY_MAX = 16
+
+
 def add_frames(sim, points_series, grid_series, step, x0):
     """One frame of both series from the simulation's current state (rank 0 calls it; the
-    points and level sets are replicated). x0: {tag: initial point positions}."""
-    for b in sim.bodies:
+    points and level sets are replicated). x0: {tag: initial point positions}. The grid frame
+    has the combined fields `phi`, `body` and `du` (`ImplicitMPM.union_fields`), and with at
+    most SERIES_PER_BODY_MAX bodies each body's `phi_<body>` and `du_<body>`; the points are
+    `material_points_<body>` per body then, else one `material_points` with a field `body`
+    (the body's index in bodies.csv's order)."""
+    per_body = len(sim.bodies) <= SERIES_PER_BODY_MAX
+    fields = []
+    for k, b in enumerate(sim.bodies):
         pts = sim.points[b.tag]
         data = {"stress": pts.stress, "volume": pts.vol, "displacement": pts.x - x0[b.tag]}
-        points_series.setdefault(b.name, Series(f"material_points_{b.name}")).add(step, pts.x, data)
+        if per_body:
+            points_series.setdefault(b.name, Series(f"material_points_{b.name}")).add(
+                step, pts.x, data
+            )
+        else:
+            fields.append((pts.x, {**data, "body": np.full(len(pts.x), float(k))}))
+    if fields:
+        data = {key: np.concatenate([f[1][key] for f in fields]) for key in fields[0][1]}
+        x = np.concatenate([f[0] for f in fields])
+        points_series.setdefault("all", Series("material_points")).add(step, x, data)
     nx, ny = len(sim.xlines), len(sim.ylines)
     X, Y = np.meshgrid(sim.xlines, sim.ylines)
     v = (np.arange(ny - 1)[:, None] * nx + np.arange(nx - 1)[None, :]).ravel()
     quads = np.stack([v, v + 1, v + nx, v + nx + 1], axis=1)
-    data = {f"phi_{b.name}": sim.levelset_values(b.tag).ravel() for b in sim.bodies}
-    for name in getattr(sim, "grid_increments", {}):
-        data[f"du_{name}"] = sim.grid_increment(name)
+    phi, body, du = sim.union_fields()
+    data = {"phi": phi, "body": body.astype(float), "du": du}
+    if per_body:
+        data.update({f"phi_{b.name}": sim.levelset_values(b.tag).ravel() for b in sim.bodies})
+        for name in getattr(sim, "grid_increments", {}):
+            data[f"du_{name}"] = sim.grid_increment(name)
     grid_series.add(step, np.stack([X.ravel(), Y.ravel()], axis=1), data, quads)
 
 
@@ -196,7 +221,9 @@ class Steps:
         self.records = run.records = []  # ImplicitMPM.step records
         self.rows = run.rows = []  # steps.csv rows
         self.points_series, self.grid_series = {}, Series("levelsets")
-        run.data["series"] = self.points_series  # {body name: Series} of the points (rank 0)
+        # {body name: Series} of the points, or {"all": Series} beyond SERIES_PER_BODY_MAX
+        # bodies (rank 0)
+        run.data["series"] = self.points_series
         self.checks = {}  # warning -> first step where it was seen
         self.series = True  # False: no time series (no frames kept, none written)
         self._x0 = None

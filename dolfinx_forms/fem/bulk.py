@@ -93,7 +93,7 @@ class BulkForms:
             pm = fem.Function(fem.FunctionSpace(mesh, ("DG", 0)), name="p_modulus")
             cell_dof = pm.function_space.dofmap.list.array
             for tag, law in self.laws.items():
-                pm.x.array[cell_dof[scene.cell_tags.find(tag)]] = law.p_modulus
+                pm.x.array[cell_dof[scene.body_cells(tag)]] = law.p_modulus
             pm.x.scatter_forward()
             self._pm = pm
             a_lin.append(integration.ghost_penalty(du, v, ghost_penalty, pm))
@@ -183,5 +183,5 @@ class BulkForms:
         sig = fem.Function(S, name="stress")
         pts = S.element.interpolation_points()
         for tag, law in self.laws.items():
-            sig.interpolate(fem.Expression(law.cauchy(self.u), pts), self.scene.cell_tags.find(tag))
+            sig.interpolate(fem.Expression(law.cauchy(self.u), pts), self.scene.body_cells(tag))
         return sig

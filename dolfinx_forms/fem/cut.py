@@ -146,7 +146,7 @@ def levelset_values(scene, V):
     cell_dofs = V.dofmap.list.array.reshape(ncells, -1)
     xdof = V.tabulate_dof_coordinates()[:, :2]
     for tag, shape in scene.cut.levelsets.items():
-        dofs = np.unique(cell_dofs[scene.cell_tags.values == tag])
+        dofs = np.unique(cell_dofs[scene.body_cells(tag)])
         if len(dofs):
             phi.x.array[dofs] = shape_values(shape, xdof[dofs])
     phi.x.scatter_forward()

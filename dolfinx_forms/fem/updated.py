@@ -226,7 +226,7 @@ class UpdatedLagrangian:
         dofs_F = self.Fn.function_space.dofmap.list.array.reshape(len(self.cells), nq)
         newF = self.Fn.x.array.reshape(-1, dd).copy()
         for t, law in self.updated.items():
-            cells = self.scene.cell_tags.find(t).astype(np.int32)
+            cells = self.scene.body_cells(t).astype(np.int32)
             if len(cells) == 0:  # none of this body on this rank
                 continue
             key = id(law)

@@ -585,12 +585,13 @@ def _basix_element(cell_type, degree):
 
 
 class BodyLocator:
-    """Point location restricted to one body's cells (C++ bins), with basis values."""
+    """Point location restricted to one body's cells (C++ bins), with basis values. cells:
+    the body's cells if known (`Scene.body_cells`), else found from cell_tags."""
 
-    def __init__(self, mesh, cell_tags, tag, cell_type, degree):
+    def __init__(self, mesh, cell_tags, tag, cell_type, degree, cells=None):
         x = mesh.geometry.x
         gdofs = mesh.geometry.dofmap.array.reshape(-1, 3 if cell_type == "triangle" else 4)
-        cells = cell_tags.indices[cell_tags.values == tag].astype(np.int32)
+        cells = (cell_tags.find(tag) if cells is None else cells).astype(np.int32)
         self.locator = _cpp.CellLocator(x, gdofs.astype(np.int32), cells)
         self.element = _basix_element(cell_type, degree)
 
@@ -613,8 +614,9 @@ def grid_locator(scene, tag, degree=1, owned_only=False):
     key = (int(tag), int(degree), bool(owned_only))
     if key not in cache:
         cache[key] = GridLocator(
-            scene.mesh, scene.cell_tags, tag, scene.cut, degree, owned_only=owned_only
-        )
+            scene.mesh, scene.cell_tags, tag, scene.cut, degree, owned_only=owned_only,
+            cells=scene.body_cells(tag),
+        )  # fmt: skip
     return cache[key]
 
 
@@ -627,12 +629,12 @@ class GridLocator:
     of the 3 x 3 neighbourhood, with extrapolated reference coordinates, if it is within
     max_distance of it. `locate` returns (cells, X, outside) like BodyLocator: outside = 0
     inside a cell, else the distance to it (inf, cell -1 and X NaN when nothing is within
-    max_distance)."""
+    max_distance). cells: the body's cells if known (`Scene.body_cells`)."""
 
-    def __init__(self, mesh, cell_tags, tag, cut, degree, owned_only=False):
+    def __init__(self, mesh, cell_tags, tag, cut, degree, owned_only=False, cells=None):
         self.xl, self.yl = np.asarray(cut.xlines), np.asarray(cut.ylines)
         g = mesh.geometry.dofmap.array.reshape(-1, 4)
-        cells = cell_tags.find(tag).astype(np.int32)
+        cells = (cell_tags.find(tag) if cells is None else cells).astype(np.int32)
         if owned_only:  # e.g. to take each point's value from one rank, partition-independently
             cells = cells[cells < mesh.topology.index_map(2).size_local]
         xv = np.ascontiguousarray(mesh.geometry.x[g[cells], :2])  # (n, 4, 2)
@@ -818,7 +820,10 @@ class _Sides:
             else (
                 grid_locator(scene, body.tag, degree)
                 if cut is not None  # structured grid: O(1) location by index
-                else BodyLocator(scene.mesh, scene.cell_tags, body.tag, scene.cell_type, degree)
+                else BodyLocator(
+                    scene.mesh, scene.cell_tags, body.tag, scene.cell_type, degree,
+                    cells=scene.body_cells(body.tag),
+                )  # fmt: skip
             )
             for body in (bi, bj)
         ]

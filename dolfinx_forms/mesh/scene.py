@@ -95,6 +95,10 @@ class CutData:
     ghost_facets: dolfinx.mesh.MeshTags  # value 1 on the interior facets touching a cut cell
 
 
+_NO_CELLS = np.zeros(0, np.int32)
+_NO_CELLS.flags.writeable = False
+
+
 @dataclass
 class Scene:
     mesh: dolfinx.mesh.Mesh  # all bodies in ONE mesh, disjoint (no shared vertices)
@@ -106,6 +110,24 @@ class Scene:
     h_contact: float  # mesh size at the contact
     cell_type: str  # "triangle" or "quadrilateral"
     cut: CutData | None = None  # structured cut-cell scenes (meshes/cut.py) only
+
+    def body_cells(self, tag) -> np.ndarray:
+        """The cells of body `tag` on this rank (owned and ghost, ascending; read-only): what
+        `cell_tags.find(tag)` returns, from one sort of the tags per scene. A scan of every cell
+        per body made each step of N grains O(N^2): 2000 scans a step at 400 grains."""
+        cache = self.__dict__.get("_body_cells")
+        if cache is None:
+            values, indices = self.cell_tags.values, self.cell_tags.indices
+            order = np.argsort(values, kind="stable")  # each body's cells stay ascending
+            tags, start = np.unique(values[order], return_index=True)
+            bounds = np.append(start, len(values))
+            cache = {}
+            for k, t in enumerate(tags):
+                cells = np.ascontiguousarray(indices[order[bounds[k] : bounds[k + 1]]])
+                cells.flags.writeable = False
+                cache[int(t)] = cells
+            self.__dict__["_body_cells"] = cache
+        return cache.get(int(tag), _NO_CELLS)
 
 
 # --------------------------------------------------------------------------- gmsh session
@@ -577,12 +599,12 @@ def summary(scene: Scene) -> str:
     comm, top = scene.mesh.comm, scene.mesh.topology
     top.create_connectivity(2, 0)
     c2v = top.connectivity(2, 0).array.reshape(len(scene.cell_tags.values), -1)
-    owned = scene.cell_tags.indices < top.index_map(2).size_local
-    parts = []
-    for b in scene.bodies:
-        mine = scene.cell_tags.values == b.tag
-        nc = comm.allreduce(int(np.sum(mine & owned)))
-        nv = comm.allreduce(int(np.sum(np.unique(c2v[mine]) < top.index_map(0).size_local)))
-        parts.append(f"{b.name}: {nc} cells, {nv} vertices")
+    owned_cells, owned_vertices = top.index_map(2).size_local, top.index_map(0).size_local
+    counts = np.zeros((len(scene.bodies), 2), np.int64)
+    for k, b in enumerate(scene.bodies):
+        cells = scene.body_cells(b.tag)
+        counts[k] = np.sum(cells < owned_cells), np.sum(np.unique(c2v[cells]) < owned_vertices)
+    counts = comm.allreduce(counts)  # one reduction, not two per body
+    parts = [f"{b.name}: {nc} cells, {nv} vertices" for b, (nc, nv) in zip(scene.bodies, counts)]
     head = f"{scene.cell_type}, {comm.size} rank(s), h_contact={scene.h_contact:g}; "
     return head + "; ".join(parts)

@@ -49,7 +49,7 @@ def evolve(sim, problem, scene):
     sim.grid_increments = {}
     big = np.iinfo(np.int64).max
     for b in sim.bodies:
-        dofs = np.unique(cell_dofs[scene.cell_tags.find(b.tag)])
+        dofs = np.unique(cell_dofs[scene.body_cells(b.tag)])
         dofs = dofs[dofs < owned]
         ib, jb = i[dofs], j[dofs]
         # known: every node of the body's active cells. The FE increment on the outside

@@ -142,7 +142,7 @@ def seed(scene, integration, tag):
     (owned cells of every rank, gathered), zero stress."""
     comm = scene.mesh.comm
     owned = scene.mesh.topology.index_map(2).size_local
-    cells = scene.cell_tags.indices[scene.cell_tags.values == tag]
+    cells = scene.body_cells(tag)
     cells = cells[cells < owned]
     kind = integration.kind[cells]
     X, w = basix.make_quadrature(basix.CellType.quadrilateral, DEGREE)

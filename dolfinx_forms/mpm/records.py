@@ -25,7 +25,7 @@ def support_forces(sim, problem, scene):
     bc[problem.bc_owned] = True
     cell_dofs = problem.V.dofmap.list.array.reshape(-1, 4)
     for b in sim.bodies:
-        nodes = np.unique(cell_dofs[scene.cell_tags.find(b.tag)])
+        nodes = np.unique(cell_dofs[scene.body_cells(b.tag)])
         nodes = nodes[2 * nodes + 1 < owned]
         f = np.zeros(2)
         for c in range(2):

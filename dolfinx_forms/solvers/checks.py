@@ -139,7 +139,7 @@ def unheld_bodies(problem):
     nb = len(bodies)
     body = np.full(n_own, -1)  # the body of each owned node (bodies are disjoint)
     for k, b in enumerate(bodies):
-        nodes = np.unique(dofmap[problem.scene.cell_tags.find(b.tag)])
+        nodes = np.unique(dofmap[problem.scene.body_cells(b.tag)])
         body[nodes[nodes < n_own]] = k
     held = body >= 0
     count = comm.allreduce(np.bincount(body[held], minlength=nb), op=MPI.SUM)

@@ -248,6 +248,18 @@ def test_scene_consistent(name):
 
 
 @pytest.mark.parametrize("name", list(BUILDERS))
+def test_body_cells_are_the_tags_find(name):
+    """Scene.body_cells (one sort per scene) returns what MeshTags.find does, body by body,
+    read-only, and no cells for a tag no cell has."""
+    s = scene(name)
+    for b in s.bodies:
+        cells = s.body_cells(b.tag)
+        assert cells.dtype == np.int32 and not cells.flags.writeable
+        assert np.array_equal(cells, s.cell_tags.find(b.tag)) and len(cells)
+    assert len(s.body_cells(99)) == 0
+
+
+@pytest.mark.parametrize("name", list(BUILDERS))
 def test_counts_from_the_grid(name):
     """Active cells per body = the window's grid cells with a negative vertex (direct count)."""
     s = scene(name)

@@ -259,11 +259,11 @@ def test_grid_levelset_obstacle_matches_its_polygon():
     assert np.max(np.linalg.norm(a - b, axis=1)) < 1e-3
 
 
-def test_disc_column_carries_the_load_through_every_contact():
+def test_disc_column_carries_the_load_through_every_contact(tmp_path, monkeypatch):
     """Three discs stacked between rigid platens, frictionless, found by the broad phase: every
     contact carries the same force (1e-6 relative; vertical resultants of the contact
     tractions) and every disc is in equilibrium (its contact resultant below 1e-8 of the
-    force)."""
+    force). Its output fields: the combined level set and the many-body point series."""
     from meshes.mpm import disc_column
 
     grid, bodies, platens, build = disc_column(COMM, 3, 10.0, 0.5, 0.1, 3)
@@ -292,6 +292,51 @@ def test_disc_column_carries_the_load_through_every_contact():
             s = rec["support_forces"][name]
             assert np.hypot(f[0] + s[0], f[1] + s[1]) <= 1e-8 * F.max(), name
     assert rec["obstacles"]["platen_top"]["fy"] == pytest.approx(F.max(), rel=1e-6)
+    # the output's combined grid fields (`union_fields`, O(grid)) against the per-body
+    # whole-grid fields (O(bodies x grid)): their minimum, its body and that body's increment
+    phi, body, du = sim.union_fields()
+    full = np.stack([sim.levelset_values(b.tag).ravel() for b in sim.bodies])
+    assert np.array_equal(phi, full.min(axis=0))
+    at = np.flatnonzero(body >= 0)
+    assert np.array_equal(full[body[at], at], phi[at])
+    assert np.array_equal(np.unique(body[at]), [0, 1, 2])
+    assert np.all(phi[body < 0] >= 0.5)  # beyond every window: the far value (>= h)
+    incs = np.stack([sim.grid_increment(b.name) for b in sim.bodies])
+    assert np.array_equal(du[at], incs[body[at], at])
+    assert not du[body < 0].any() and np.abs(du).max() > 0
+    _many_bodies_series(sim, rec, tmp_path, monkeypatch)
+
+
+def _many_bodies_series(sim, rec, folder, monkeypatch):
+    """Beyond SERIES_PER_BODY_MAX bodies (here 2 of 3): one point series of all bodies with
+    their index, and the level-set grid with the combined fields only, read back by meshio."""
+    import meshio
+
+    from dolfinx_forms.app import mpm_run
+
+    monkeypatch.setattr(mpm_run, "SERIES_PER_BODY_MAX", 2)
+    points, grid = {}, mpm_run.Series("levelsets")
+    x0 = {t: p.x for t, p in sim.points.items()}
+    mpm_run.add_frames(sim, points, grid, rec["step"], x0)
+    assert list(points) == ["all"]
+    for series in [*points.values(), grid]:
+        series.write(folder)
+    assert sorted(p.name for p in folder.glob("*.xdmf")) == [
+        "levelsets.xdmf",
+        "material_points.xdmf",
+    ]
+    with meshio.xdmf.TimeSeriesReader(folder / "material_points.xdmf") as r:
+        r.read_points_cells()
+        data = r.read_data(0)[1]
+    sizes = [len(sim.points[b.tag]) for b in sim.bodies]
+    assert np.array_equal(np.bincount(data["body"].astype(int)), sizes)
+    vol = np.concatenate([sim.points[b.tag].vol for b in sim.bodies])
+    assert np.array_equal(data["volume"], vol)
+    with meshio.xdmf.TimeSeriesReader(folder / "levelsets.xdmf") as r:
+        r.read_points_cells()
+        data = r.read_data(0)[1]
+    assert sorted(data) == ["body", "du", "phi"]
+    assert np.array_equal(data["phi"], sim.union_fields()[0])
 
 
 def test_hexagonal_assembly_of_ellipses_in_rigid_plates():
