@@ -43,6 +43,7 @@ __all__ = [
     "check_cells",
     "contact_partitioner",
     "cell_bboxes",
+    "box_hits",
     "add_polygon",
     "on_box_side",
     "summary",
@@ -311,6 +312,25 @@ def _facet_neighbours(cells: np.ndarray, cell_name: str) -> tuple[np.ndarray, np
     return owner[pair_start[0]], owner[pair_start[1]]
 
 
+def box_hits(lo: np.ndarray, hi: np.ndarray, boxes: np.ndarray) -> list[np.ndarray]:
+    """For each box (2, 2) of `boxes` the cells (ascending) whose bounding box [lo, hi] (n, 2)
+    meets it (closed sets): one sort of the cells by lo_x and a range per box, so a box costs
+    the cells of its column, not all n (a scan per box made the partition of N grains' mesh
+    O(N^2): 1181 boxes x 150k cells at 400 grains)."""
+    if len(lo) == 0:
+        return [np.zeros(0, np.int64) for _ in boxes]
+    order = np.argsort(lo[:, 0], kind="stable")
+    lox = lo[order, 0]
+    reach = 2.0 * float(np.max(hi[:, 0] - lo[:, 0]))  # hi_x >= box_lo_x needs lo_x >= this
+    out = []
+    for box in boxes:
+        a = np.searchsorted(lox, box[0, 0] - reach, side="left")
+        b = np.searchsorted(lox, box[1, 0], side="right")
+        c = order[a:b]
+        out.append(np.sort(c[np.all((lo[c] <= box[1]) & (hi[c] >= box[0]), axis=1)]))
+    return out
+
+
 def pairs_contact_boxes(bodies, pairs, h_contact, margin=CONTACT_BOX_MARGIN) -> np.ndarray:
     """Boxes (k, 2, 2) whose union holds every contact: for each pair (i, j) whose bounding
     boxes, inflated by margin h_contact, overlap, that overlap (k = 0: no pair can touch)."""
@@ -381,8 +401,7 @@ def contact_partitioner(x: np.ndarray, cells: np.ndarray, cell_name: str, contac
             centroid = 0.5 * (lo + hi)
             owner[:] = -1
             box_cells = []  # (cells, rank) of each box, last box first
-            for box, r in zip(boxes[::-1], owners[::-1] % nparts):
-                hit = np.flatnonzero(np.all((lo <= box[1]) & (hi >= box[0]), axis=1))
+            for hit, r in zip(box_hits(lo, hi, boxes[::-1]), owners[::-1] % nparts):
                 owner[hit] = r
                 box_cells.append((hit, r))
             rest = np.flatnonzero(owner < 0)

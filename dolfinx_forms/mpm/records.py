@@ -112,15 +112,18 @@ def contact_record(sim, problem, scene, keys):
     # contact resultants on each body: +sum w (tau_n n + tau_t t) on side i, the opposite on
     # side j; moment about the body's material-point centroid
     forces = {b.name: np.zeros(3) for b in sim.bodies}
+    tags, centroids = {b.name: b.tag for b in sim.bodies}, {}
     for k, g in enumerate(cs.pairs):
         s = cs.committed[k]
         for side, name, p in (("i", keys[k][0], g.p_i), ("j", keys[k][1], g.p_j)):
             if name in forces:
-                b = next(b for b in sim.bodies if b.name == name)
-                c = np.average(sim.points[b.tag].x, axis=0, weights=sim.points[b.tag].vol)
-                F, M = traction_resultant(g, s, side, p, c)
+                if name not in centroids:  # once per body, not per pair
+                    pts = sim.points[tags[name]]
+                    centroids[name] = np.average(pts.x, axis=0, weights=pts.vol)
+                F, M = traction_resultant(g, s, side, p, centroids[name])
                 forces[name] += np.array([F[0], F[1], M])
-    body_forces = {n: allreduce_array(sim.comm, v, MPI.SUM).tolist() for n, v in forces.items()}
+    total = allreduce_array(sim.comm, np.array(list(forces.values())).reshape(-1, 3), MPI.SUM)
+    body_forces = dict(zip(forces, total.tolist()))  # one reduction for all bodies
     obstacles = obstacle_forces(problem, sim.obstacles)
     return dict(pairs=pairs, obstacles=obstacles, body_forces=body_forces)
 
