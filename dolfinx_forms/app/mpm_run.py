@@ -357,10 +357,11 @@ def plot_force_chains(sim, record, path, title="force chains"):
     image, extent = binned_mean(x, mean, sim.h)
     sc = ax.imshow(image, extent=extent, origin="lower", cmap="Greys_r", vmin=lo, vmax=0)
     # the bodies' outlines (their level sets' zero contours) and the rigid obstacles'
+    for b in sim.bodies:  # on its window: the whole grid per body costs bodies x grid
+        i0, i1, j0, j1 = sim.windows[b.tag]
+        x, y, phi = sim.xlines[i0 : i1 + 1], sim.ylines[j0 : j1 + 1], sim.levelsets[b.tag].values
+        ax.contour(x, y, phi, [0.0], colors="tab:blue", linewidths=0.6)
     X, Y = np.meshgrid(sim.xlines, sim.ylines)
-    for b in sim.bodies:
-        phi = sim.levelset_values(b.tag)
-        ax.contour(X, Y, phi, [0.0], colors="tab:blue", linewidths=0.6)
     xy = np.c_[X.ravel(), Y.ravel()]
     for ob in getattr(sim, "obstacles", ()):
         phi = np.asarray(ob.values(xy)).reshape(X.shape)
