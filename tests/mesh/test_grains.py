@@ -188,3 +188,31 @@ def test_pack_errors():
         g.pack_grains(outl, [[0, 0], [10, 10]], gap=-1)
     with pytest.raises(ValueError, match="box"):
         g.pack_grains(outl, [[0, 0], [-1, 10]])
+
+
+def _covered(n, cols):
+    """Every grain of the last full row has a grain of the row above at +-1/2 a spacing (rows
+    of `cols`, odd rows shifted by 1/2, the last row partial): the lattice itself, counted."""
+    k = np.arange(n)
+    i, j = k % cols, k // cols
+    x = i + 0.5 * (j % 2)
+    top = n // cols - 1  # the last full row
+    above = set(x[j == top + 1].tolist())
+    return j.max() == top or all({v - 0.5, v + 0.5} & above for v in x[j == top])
+
+
+def test_assembly_rows_hold_every_grain():
+    """meshes.assembly.held_rows is the lattice's own count (every n <= 120, every row length),
+    the layouts that ran keep their rows (9, 12, 15, 100, 400 grains), and the counts whose
+    last row left a grain without a neighbour above (7, 700, 1000: they failed at the first
+    step) get a row length that holds every grain."""
+    from meshes.assembly import held_rows, lattice_columns
+
+    for n in range(2, 121):
+        for cols in range(1, n + 1):
+            assert held_rows(n, cols) == _covered(n, cols), (n, cols)
+    assert [lattice_columns(n) for n in (9, 12, 15, 100, 400)] == [3, 4, 4, 10, 20]
+    for n in (7, 700, 1000):
+        assert not held_rows(n, int(np.ceil(np.sqrt(n))))
+        assert _covered(n, lattice_columns(n))
+    assert [lattice_columns(n) for n in (7, 700, 1000)] == [2, 25, 25]
