@@ -10,8 +10,8 @@ OUT     ?= results
 JOBS    ?= 2
 APT_PACKAGES := cmake make gcc g++ python3-sympy python3-dolfinx libdolfinx-dev python3-gmsh gmsh \
 	libeigen3-dev python3-mpi4py python3-meshio pybind11-dev python3-pytest \
-	python3-scipy python3-matplotlib libgtest-dev libbenchmark-dev python3-setuptools \
-	python3-venv openmpi-bin libnanoflann-dev libopenblas0-pthread python3-h5py
+	python3-scipy python3-matplotlib python3-contourpy libgtest-dev libbenchmark-dev \
+	python3-setuptools python3-venv openmpi-bin libnanoflann-dev libopenblas0-pthread python3-h5py
 # only `make bench` installs these: benchmarks/work_precision.py compares with GetFEM's nodal P1,
 # benchmarks/dem_peer.py runs LAMMPS's GRANULAR package (lmp) on demos/granular_column.py's test
 BENCH_PACKAGES := python3-getfem lammps
