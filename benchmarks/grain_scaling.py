@@ -66,6 +66,10 @@ def run(grains, ranks, steps, timeout, tmp):
         dofs=m["mesh"]["num_dofs"] if "mesh" in m else None,
         newton_per_step=sum(m["solver"]["newton_iterations"]) / steps,
         factorisations=sum(m["solver"]["factorisations"]),
+        # what besides Newton's iterations factorises: cut-backs, split steps, wider sparsity
+        cutbacks=m["solver"].get("cutbacks", 0),
+        substeps=sum(m["solver"].get("substeps", [])),
+        coupling_rebuilds=sum(m["solver"].get("coupling_rebuilds", [])),
         total=t["total"],
         step=t["total"] / steps,
         **{f"step_{k}": t.get(k, 0.0) / steps for k in PHASES},

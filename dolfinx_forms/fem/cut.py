@@ -273,7 +273,9 @@ class CutIntegration:
         facets = self.scene.cut.ghost_facets.indices
         if len(facets) == 0:
             return
-        cells = np.array([f2c.links(f) for f in facets])  # two cells per interior facet
+        # two cells per interior facet (a ghost facet is one), read off the CSR arrays: a
+        # Python loop over the facets cost 0.15 s a step at 400 grains
+        cells = f2c.array[f2c.offsets[facets][:, None] + np.arange(2)]
         dofs = V.dofmap.list.array.reshape(-1, 4)
         _cpp.insert_blocks(pattern, np.hstack([dofs[cells[:, 0]], dofs[cells[:, 1]]]))
 
