@@ -25,7 +25,8 @@ def held_rows(n, cols):
     row is full, or odd with cols - 1 grains (it then covers both ends of the even row below).
     A grain with neighbours below and beside only is pushed out of the row by the compression
     and, once its contacts slip, turns almost freely: 7 grains (3 + 3 + 1), 700 (27 per row,
-    25 in the last) and 1000 (32 per row, 8 in the last) failed at their first step so."""
+    25 in the last) and 1000 (32 per row, 8 in the last) failed at their first step with
+    ceil(sqrt(n)) grains per row."""
     full, rest = divmod(int(n), int(cols))
     return rest == 0 or (full % 2 == 1 and rest == cols - 1)
 

@@ -530,14 +530,17 @@ class ImplicitMPM:
         self.levelsets[tag] = _cpp.LevelSet(self.subgrid(new), values.ravel())
         self.windows[tag] = new
 
+    def _beyond_window(self, tag):
+        """Body `tag`'s level-set value beyond its window in the whole-grid views: its largest
+        value there, at least h (positive: the zero contour lies inside the window)."""
+        return max(float(self.levelsets[tag].values.max()), self.h)
+
     def levelset_values(self, tag):
         """Body `tag`'s level set on the whole grid, (ny, nx): its window's values, and beyond
-        the window its largest value there (positive: the zero contour lies inside). For output
-        and plots."""
+        the window `_beyond_window`. For output and plots."""
         i0, i1, j0, j1 = self.windows[tag]
-        v = self.levelsets[tag].values
-        full = np.full((len(self.ylines), len(self.xlines)), max(float(v.max()), self.h))
-        full[j0 : j1 + 1, i0 : i1 + 1] = v
+        full = np.full((len(self.ylines), len(self.xlines)), self._beyond_window(tag))
+        full[j0 : j1 + 1, i0 : i1 + 1] = self.levelsets[tag].values
         return full
 
     def grid_increment(self, name):
@@ -556,9 +559,9 @@ class ImplicitMPM:
         body whose window value gives it (the first of equals), -1 where it is a value beyond
         a window; du (nx ny, 2): that body's extended step increment (`grid_increment`)."""
         shape = (len(self.ylines), len(self.xlines))
-        # beyond its window a body's value is max(its largest, h); no window value is above
-        # that, so seeding with the smallest of them gives the minimum of the whole-grid fields
-        far = min(max(float(self.levelsets[b.tag].values.max()), self.h) for b in self.bodies)
+        # no window value is above its body's `_beyond_window`, so seeding with the smallest
+        # of those gives the minimum of the whole-grid fields
+        far = min(self._beyond_window(b.tag) for b in self.bodies)
         phi, body = np.full(shape, far), np.full(shape, -1, np.int32)
         for k, b in enumerate(self.bodies):
             i0, i1, j0, j1 = self.windows[b.tag]
