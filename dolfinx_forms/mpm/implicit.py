@@ -461,6 +461,9 @@ class ImplicitMPM:
             wall_s=time.perf_counter() - t0,
             **evo,
         )
+        # the next step factorises its own mesh's J: this one's factors go before it does
+        # (400 grains: peak memory 2.80 -> 2.32 GB)
+        problem.release_solver()
         return record
 
     # ------------------------------------------------------------------ level-set windows

@@ -194,6 +194,15 @@ class Factorised:
         """A solver like this one (options, LDL^T or LU as it is now) for problem's new J."""
         return Factorised(problem, self.petsc_options, self.symmetric)
 
+    def release(self):
+        """Free the factorisation (and LDL^T's eliminated copy of J); the next `setup`
+        factorises again. A converged material-point step calls it: the next step has a new
+        mesh and its own solver, and would otherwise factorise while this factor (~130 MB at
+        80k dofs) is still held."""
+        self.ksp.reset()
+        destroy(self.A)
+        self.A = self.J = self.key = None
+
     def solve(self, b, x):
         rhs, lifted = self.dirichlet.rhs(self.J, b) if self.symmetric else (b, False)
         self.ksp.solve(rhs, x)
@@ -288,6 +297,8 @@ class Condensed:
         self.J = J
         if key is not None and key == self.key:
             return
+        if self.F is None:  # released
+            self._factor(self.symmetric)
         self.key = key
         self.operator = next(_OPERATORS)
         t0 = time.perf_counter()
@@ -315,6 +326,13 @@ class Condensed:
             self.full.setup(J, None)
             self.full.operator = self.operator
             return
+
+    def release(self):
+        """Free the factorisations (`Factorised.release`); the next `setup` makes them again."""
+        if self.full is not None:
+            return self.full.release()
+        destroy(self.F)
+        self.F = self.S = self.base = self.J = self.key = None
 
     def _schur(self, Jcc):
         """S = S0 + (J_cc - K0_cc) into self.S; whether it is symmetric. With the LDL^T factor
@@ -444,6 +462,11 @@ class Iterative:
         destroy(self.ksp, self.A)
         self.dirichlet.destroy()
         self.ksp = self.A = self.J = None
+
+    def release(self):
+        """Free the AMG hierarchy (`Factorised.release`); the next `setup` builds it again."""
+        self.ksp.reset()
+        self.key, self.fresh, self.rebuild = None, None, True
 
     def _true_residual(self):
         """Test |J x - b| itself (the tolerances are forces): CG's default norm is the

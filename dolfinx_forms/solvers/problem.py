@@ -272,6 +272,11 @@ class ContactProblem:
         linear.destroy(self.K, self.J, self.R, self.Ku, self.f)
         self.K = self.J = self.R = self.Ku = self.f = None
 
+    def release_solver(self):
+        """Free the linear solver's factorisations (`Factorised.release`): the problem stays
+        usable (a later solve factorises again)."""
+        self.linear.release()
+
     # ------------------------------------------------------------------ utilities
     @property
     def factorisations(self):

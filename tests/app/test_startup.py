@@ -211,3 +211,61 @@ print(json.dumps(dict(libs=len(maps), nodes=n)))
         out[mode] = json.loads(p.stdout.strip().splitlines()[-1])
     assert out["preload"]["libs"] == 1
     assert out["preload"]["nodes"] == out["first"]["nodes"] > 50
+
+
+HUGE = """
+HUGE_PAGES = True
+import json, os
+import dolfinx_forms.app
+print(json.dumps(dict(tunables=os.environ.get("GLIBC_TUNABLES"))))
+"""
+
+
+def test_huge_pages_restart_rules():
+    """Who is restarted with huge pages (startup.huge_pages_restart): a script that declares
+    HUGE_PAGES, with THP in "madvise" mode and glibc >= 2.35, once; the user's own tunables kept;
+    ILS_HUGE_PAGES=0 turns it off."""
+    from types import SimpleNamespace
+
+    from dolfinx_forms.app import startup
+
+    main, mode, libc = SimpleNamespace(HUGE_PAGES=True), "always [madvise] never", "glibc 2.36"
+    exe, argv, env = startup.huge_pages_restart(main, {"A": "1"}, mode, libc)
+    assert exe == sys.executable and argv == sys.orig_argv
+    assert env == {"A": "1", "GLIBC_TUNABLES": "glibc.malloc.hugetlb=1"}
+    user = {"GLIBC_TUNABLES": "glibc.malloc.arena_max=2"}
+    env = startup.huge_pages_restart(main, user, mode, libc)[2]
+    assert env["GLIBC_TUNABLES"] == "glibc.malloc.arena_max=2:glibc.malloc.hugetlb=1"
+    for args in [
+        (SimpleNamespace(), {}, mode, libc),  # not declared
+        (main, {"ILS_HUGE_PAGES": "0"}, mode, libc),
+        (main, {"GLIBC_TUNABLES": "glibc.malloc.hugetlb=0"}, mode, libc),  # the user's choice
+        (main, env, mode, libc),  # restarted already
+        (main, {}, "[always] madvise never", libc),  # huge already
+        (main, {}, "always madvise [never]", libc),
+        (main, {}, mode, "glibc 2.31"),
+        (main, {}, mode, ""),  # another C library
+    ]:
+        assert startup.huge_pages_restart(*args) is None, args
+
+
+def test_huge_pages_demo_process(tmp_path):
+    """A process that declares HUGE_PAGES runs on with the tunable where this machine allows it
+    (and once: the restarted process does not restart again), without it under
+    ILS_HUGE_PAGES=0."""
+    from types import SimpleNamespace
+
+    from dolfinx_forms.app import startup
+
+    clean = {k: v for k, v in os.environ.items() if k not in ("GLIBC_TUNABLES", "ILS_HUGE_PAGES")}
+    allowed = startup.huge_pages_restart(SimpleNamespace(HUGE_PAGES=True), clean) is not None
+    env = dict(clean, PYTHONPATH=str(ROOT))
+    for k in ("OMPI_MCA_pml", "OMPI_MCA_btl"):
+        env.pop(k, None)
+    for off, expected in [("1", "glibc.malloc.hugetlb=1" if allowed else None), ("0", None)]:
+        p = subprocess.run(
+            [sys.executable, "-c", HUGE], env=dict(env, ILS_HUGE_PAGES=off), capture_output=True,
+            text=True, timeout=120,
+        )
+        assert p.returncode == 0, p.stderr
+        assert json.loads(p.stdout.strip().splitlines()[-1])["tunables"] == expected

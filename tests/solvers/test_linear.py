@@ -109,6 +109,32 @@ def test_invert_in_place():
         linear._invert(np.zeros((3, 3)))
 
 
+@pytest.mark.parametrize("solver", ["condensed", "factorised", "lu"])
+def test_release_frees_the_factors_and_solves_again(solver):
+    """`release` (what a converged MPM step calls: the next step has its own solver): the
+    factors are gone, and the next setup factorises again and solves as before."""
+    pb, top_x, top_y = hertz_problem(scene("cut"), "factorised" if solver == "lu" else solver)
+    if solver == "lu":
+        pb.linear = linear.Factorised(pb)
+    protocol.reach_force(pb, top_y, "block_bottom", 1, P, first_guess=-0.05)
+    b = pb.R.duplicate()
+    b.array[:] = np.linspace(-1.0, 1.0, len(b.array))
+    x0, x1 = b.duplicate(), b.duplicate()
+    pb.linear.setup(pb.J, None)
+    pb.linear.solve(b, x0)
+    n = pb.factorisations
+    pb.release_solver()
+    if solver == "condensed":
+        assert pb.linear.F is None and pb.linear.S is None
+    else:
+        with pytest.raises(Exception):  # no factor left on the PC
+            pb.linear.ksp.getPC().getFactorMatrix()
+    pb.linear.setup(pb.J, None)
+    pb.linear.solve(b, x1)
+    assert pb.factorisations == n + 1
+    assert np.abs(x1.array - x0.array).max() <= 1e-10 * np.abs(x0.array).max()
+
+
 @pytest.mark.parametrize("kind", ["conforming", "cut"])
 def test_symmetric_factor_while_frictionless(kind):
     """Normal force only: the bulk stays factorised once, as LDL^T with the Dirichlet columns
