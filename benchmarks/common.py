@@ -26,6 +26,22 @@ WRAP = (
 )
 
 
+def huge_pages_env():
+    """The variables under which a multi-step demo runs (its start-up restarts it with them,
+    `dolfinx_forms.app.startup.huge_pages_restart`), or {} where this machine runs it without:
+    for a reference run beside it, so that both get the same memory allocator."""
+    from types import SimpleNamespace
+
+    # the module alone: importing dolfinx_forms.app would start the application here (MPI)
+    spec = importlib.util.spec_from_file_location(
+        "_startup", ROOT / "dolfinx_forms" / "app" / "startup.py"
+    )
+    startup = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(startup)
+    command = startup.huge_pages_restart(SimpleNamespace(HUGE_PAGES=True), dict(os.environ))
+    return {} if command is None else {"GLIBC_TUNABLES": command[2]["GLIBC_TUNABLES"]}
+
+
 def write_atomic(path, writer):
     """writer(tmp_path) writes the file; it then replaces `path` in one rename (a reader sees
     the old file or the new one, never a part)."""
@@ -84,10 +100,10 @@ def git_head():
         return dict(commit=None, modified=None)
 
 
-def child(cmd, timeout):
-    """Run the script cmd[0] with arguments cmd[1:]; returns (returncode, stdout, stderr, wall
-    seconds, peak RSS in MB)."""
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
+def child(cmd, timeout, env=None):
+    """Run the script cmd[0] with arguments cmd[1:] (env: variables added to this process's);
+    returns (returncode, stdout, stderr, wall seconds, peak RSS in MB)."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT), **(env or {}))
     t0 = time.perf_counter()
     proc = subprocess.Popen(
         [sys.executable, "-c", WRAP, *cmd],

@@ -25,7 +25,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from benchmarks.common import child, git_head, write_json, write_text
+from benchmarks.common import child, git_head, huge_pages_env, write_json, write_text
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -90,7 +90,7 @@ def reference_main(dofs, steps):
 
 def reference(dofs, steps, timeout):
     cmd = [str(ROOT / "benchmarks" / "mpm_cost.py"), "--reference", str(dofs), str(steps)]
-    rc, so, se, _, rss = child(cmd, timeout)
+    rc, so, se, _, rss = child(cmd, timeout, huge_pages_env())  # the demo's allocator
     if rc:
         raise RuntimeError(f"reference failed: {se.strip().splitlines()[-1:]}")
     return dict(json.loads(so.strip().splitlines()[-1]), peak_rss_mb=rss)
@@ -136,7 +136,7 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "disc"
         demo = [str(ROOT / "demos" / "brazilian_disc.py"), "--out", str(out), *extra]
-        rc, so, se, wall, rss = child(demo, args.timeout)
+        rc, so, se, wall, rss = child(demo, args.timeout, huge_pages_env())
         if rc:
             print(se, file=sys.stderr)
             return 1
@@ -148,6 +148,7 @@ def main(argv=None):
     t = m["timing_s"]
     result = dict(
         git=git_head(),
+        environment=huge_pages_env(),  # both children's (the demo's start-up restart)
         demo=dict(
             args=extra,
             dofs=dofs,
