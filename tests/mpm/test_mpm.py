@@ -10,6 +10,7 @@ from dolfinx_forms.fem.boundary import Dirichlet
 from dolfinx_forms.geometry.obstacles import RigidObstacle
 from dolfinx_forms.mesh.cut_scene import half_plane
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
+from dolfinx_forms.solvers import linear
 from dolfinx_forms.solvers.newton import ContactSolverError, NewtonOptions
 from meshes.mpm import brazilian_disc, grid_scene, uniform_lines
 
@@ -197,14 +198,20 @@ def test_rejected_step_is_invisible():
 def test_each_step_frees_the_problem_it_replaces(monkeypatch):
     """petsc4py frees no PETSc object when garbage-collected (each step would keep its
     matrices and factorisation): a step destroys the problem it replaces, a failed step the
-    problem it made, and the current problem stays whole."""
+    problem it made, and the current problem stays whole but for its factorisation, freed
+    once its step converged (the next step makes its own)."""
     from dolfinx_forms.solvers.problem import ContactProblem
 
     sim = disc_sim(steps=3)
     sim.step()
     old = sim.problem
-    handles = [old.K, old.J, old.R, old.f, getattr(old.linear, "F", None) or old.linear.ksp]
+    handles = [old.K, old.J, old.R, old.f]
     assert all(h.handle != 0 for h in handles)
+    if isinstance(old.linear, linear.Condensed):
+        assert old.linear.F is None  # released
+    else:
+        with pytest.raises(Exception):
+            old.linear.ksp.getPC().getFactorMatrix()
     sim.step()
     assert sim.problem is not old and all(h.handle == 0 for h in handles)
     cur = sim.problem
@@ -713,7 +720,7 @@ def test_increment_keys_and_predictor_round_trip():
     assert np.allclose(p.u.x.array, u, rtol=1e-15, atol=0.0)
 
 
-def test_an_mpm_step_factorises_with_the_short_lived_ordering():
+def test_an_mpm_step_factorises_with_the_short_lived_ordering(monkeypatch):
     """An MPM step's problem serves one load step: `Factorised` has MUMPS order it by AMD
     (ICNTL(7) = 0, INFOG(7) the ordering used) for that analysis only; the option does not
     stay in PETSc's options for the problems that follow."""
@@ -721,13 +728,21 @@ def test_an_mpm_step_factorises_with_the_short_lived_ordering():
 
     from dolfinx_forms.solvers.linear import SHORT_LIVED_ORDERING
 
+    used = []  # INFOG(7) of each factorisation, read before a converged step frees it
+    release = linear.Factorised.release
+
+    def read_then_release(lin):
+        used.append(lin.ksp.getPC().getFactorMatrix().getMumpsInfog(7))
+        release(lin)
+
+    monkeypatch.setattr(linear.Factorised, "release", read_then_release)
     sim = disc_sim(steps=2, linear_solver="factorised")
     sim.step()
     lin = sim.problem.linear
     assert lin.name == "factorised" and lin.ordering == SHORT_LIVED_ORDERING == 0
-    assert lin.ksp.getPC().getFactorMatrix().getMumpsInfog(7) == SHORT_LIVED_ORDERING
+    assert used == [SHORT_LIVED_ORDERING]
     assert not PETSc.Options().hasName("ils_mat_mumps_icntl_7")
     user = disc_sim(steps=2, linear_solver="factorised", petsc_options={"mat_mumps_icntl_7": 4})
     user.step()
     assert user.problem.linear.ordering is None  # the user's choice stands
-    assert user.problem.linear.ksp.getPC().getFactorMatrix().getMumpsInfog(7) == 4  # PORD
+    assert used == [SHORT_LIVED_ORDERING, 4]  # PORD
