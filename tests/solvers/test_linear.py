@@ -109,10 +109,11 @@ def test_invert_in_place():
         linear._invert(np.zeros((3, 3)))
 
 
-@pytest.mark.parametrize("solver", ["condensed", "factorised", "lu"])
+@pytest.mark.parametrize("solver", ["condensed", "factorised", "lu", "iterative"])
 def test_release_frees_the_factors_and_solves_again(solver):
     """`release` (what a converged MPM step calls: the next step has its own solver): the
-    factors are gone, and the next setup factorises again and solves as before."""
+    factors are gone, and the next setup factorises again and solves as before (`Iterative`
+    keeps its AMG hierarchy and solves as before)."""
     pb, top_x, top_y = hertz_problem(scene("cut"), "factorised" if solver == "lu" else solver)
     if solver == "lu":
         pb.linear = linear.Factorised(pb)
@@ -126,6 +127,8 @@ def test_release_frees_the_factors_and_solves_again(solver):
     pb.release_solver()
     if solver == "condensed":
         assert pb.linear.F is None and pb.linear.S is None
+    elif solver == "iterative":
+        n -= 1  # the AMG hierarchy is kept (`Iterative.release`): no new set-up
     else:
         with pytest.raises(Exception):  # no factor left on the PC
             pb.linear.ksp.getPC().getFactorMatrix()
