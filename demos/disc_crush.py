@@ -19,10 +19,7 @@ from functools import partial
 
 import numpy as np
 
-# A step per mesh, each with fresh matrices and factorisations: start-up restarts the process
-# with huge pages for large allocations (dolfinx_forms/app/startup.py, huge_pages_restart)
-HUGE_PAGES = True
-
+HUGE_PAGES = True  # a mesh and factorisation per step: restart with huge pages (app/startup.py)
 if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNotFoundError
     sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
              "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip

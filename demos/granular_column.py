@@ -25,10 +25,7 @@ import sys
 
 import numpy as np
 
-# A step per mesh, each with fresh matrices and factorisations: start-up restarts the process
-# with huge pages for large allocations (dolfinx_forms/app/startup.py, huge_pages_restart)
-HUGE_PAGES = True
-
+HUGE_PAGES = True  # a mesh and factorisation per step: restart with huge pages (app/startup.py)
 if importlib.util.find_spec("dolfinx_forms") is None:  # a hint, not a ModuleNotFoundError
     sys.exit(f"{sys.argv[0]}: dolfinx_forms not found: run `make build`, then "
              "`export PYTHONPATH=$PWD` in the repository (README.md, Installation)")  # fmt: skip
@@ -70,8 +67,7 @@ OPTIONS = [  # option, kind, default[, help]
     ("--series-every", range(1, 10001), 50, "steps between frames of the time series"),
 ]
 COLUMNS = column.COLUMNS + ["dt", "newton_iterations", "retries", "wall_s"]
-# a failed step is done again at half dt, at once (no load cut-back: granular_column.md)
-NEWTON = NewtonOptions(max_cutbacks=0)
+NEWTON = NewtonOptions(max_cutbacks=0)  # a failed step: again at half dt (granular_column.md)
 # fmt: on
 
 
