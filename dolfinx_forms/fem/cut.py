@@ -170,10 +170,21 @@ class BodyMeasure:
         self.parts = parts  # [(ufl Measure, factor or None)]
 
     def __rmul__(self, integrand):
-        form = 0
+        # UFL expands a measure over a tuple of ids into one form per id summed one by one, each
+        # sum a new Form that traverses all integrals so far: O(ids^2) (100 grains: 11 ms a
+        # form). The same integrals, one per id, in one Form instead.
+        integrals = []
         for dx, factor in self.parts:
-            form += (integrand if factor is None else integrand * factor) * dx
-        return form
+            f = integrand if factor is None else integrand * factor
+            ids = dx.subdomain_id()
+            if not isinstance(ids, tuple):
+                integrals += (f * dx).integrals()
+                continue
+            if not ids:
+                continue
+            one = (f * dx.reconstruct(subdomain_id=ids[0])).integrals()
+            integrals += [i.reconstruct(subdomain_id=d) for d in ids for i in one]
+        return ufl.Form(integrals)
 
 
 class CutIntegration:

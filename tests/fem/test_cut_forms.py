@@ -135,6 +135,28 @@ def test_cut_energy_equals_sub_triangle_rule():
         assert energy == pytest.approx(ref, rel=1e-12)
 
 
+def test_measure_over_many_bodies_is_ufls_own_expansion():
+    # BodyMeasure builds one integral per body id in one Form; UFL's `integrand * dx(ids)` sums
+    # a Form per id: the same integrals, so the same FFCx signature (the same compiled form)
+    scene, phi, _ = _scene(nx=8)
+    nc = len(scene.cell_tags.values)
+    scene.cell_tags = dmesh.meshtags(
+        scene.mesh, 2, np.arange(nc, dtype=np.int32), (1 + np.arange(nc) % 3).astype(np.int32)
+    )
+    cut = CutIntegration(scene, phi=phi)
+    V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
+    u, v = fem.Function(V), ufl.TestFunction(V)
+    integrand = ufl.inner(LAW.stress(u), ufl.grad(v))
+    form = integrand * cut.measure([1, 2, 3])
+    reference = sum(
+        (integrand if f is None else integrand * f) * dx for dx, f in cut.measure([1, 2, 3]).parts
+    )
+    assert len(form.integrals()) == len(reference.integrals()) == 6
+    assert form.signature() == reference.signature()
+    b = [fem.petsc.assemble_vector(fem.form(f)) for f in (form, reference)]
+    assert np.allclose(b[0].array, b[1].array, rtol=0, atol=1e-14 * np.abs(b[1].array).max())
+
+
 def test_body_force_is_the_inside_integral():
     # f = (1, x): total x-force = inside area, total y-force = int x over the inside
     scene, phi, kind = _scene(8, 5, lambda x: np.hypot(x[0] - 1.1, x[1] - 0.45) - 0.37)

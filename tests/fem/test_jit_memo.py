@@ -70,3 +70,40 @@ def test_one_compiled_object_per_key_and_the_right_values():
 @pytest.mark.mpi
 def test_one_compiled_object_per_key_on_two_ranks():
     test_one_compiled_object_per_key_and_the_right_values()
+
+
+def test_forms_over_many_ids_keyed_by_their_groups():
+    # integrals that differ in their subdomain id only are keyed by one representative and the
+    # ids of each group: the same structure on another mesh hits, any other grouping misses
+    jit_memo.install()
+    memo = jit_memo._memo
+
+    def tagged(n):  # cells tagged 1, 2, 3 by column thirds of the unit square
+        m = _square(n, 1.0)
+        nc = m.topology.index_map(2).size_local + m.topology.index_map(2).num_ghosts
+        x = dmesh.compute_midpoints(m, 2, np.arange(nc, dtype=np.int32))[:, 0]
+        tags = dmesh.meshtags(m, 2, np.arange(nc, dtype=np.int32),
+                              (1 + np.minimum(3 * x, 2)).astype(np.int32))  # fmt: skip
+        return m, ufl.Measure("dx", domain=m, subdomain_data=tags)
+
+    def total(dx, a_ids, b_ids, deg=2):
+        x = ufl.SpatialCoordinate(dx.ufl_domain())
+        form = sum(x[0] ** deg * dx(i) for i in a_ids) + sum(7.0 * dx(i) for i in b_ids)
+        return _total(fem.form(form))
+
+    def exact(a_ids, b_ids):  # int of x^2 and of 7 over the thirds
+        third = [((k + 1) ** 3 - k**3) / 81.0 for k in range(3)]
+        return sum(third[i - 1] for i in a_ids) + sum(7.0 / 3.0 for _ in b_ids)
+
+    (_, dx1), (_, dx2) = tagged(6), tagged(9)
+    n = len(memo)
+    assert np.isclose(total(dx1, (1, 2), (3,)), exact((1, 2), (3,)))
+    assert len(memo) == n + 1
+    assert np.isclose(total(dx2, (1, 2), (3,)), exact((1, 2), (3,)))  # another mesh: a hit
+    assert len(memo) == n + 1
+    for a_ids, b_ids in (((1,), (2, 3)), ((1, 2), (1,)), ((1, 2), (2,)), ((1, 2, 3), ())):
+        assert np.isclose(total(dx2, a_ids, b_ids), exact(a_ids, b_ids))
+    assert len(memo) == n + 5
+    # an integrand that differs (x^3) with the same ids: a new entry
+    assert not np.isclose(total(dx2, (1, 2), (3,), deg=3), exact((1, 2), (3,)))
+    assert len(memo) == n + 6
