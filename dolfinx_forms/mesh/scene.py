@@ -302,12 +302,14 @@ def max_edge_in_box(x: np.ndarray, cells: np.ndarray, box) -> float:
 def _facet_neighbours(cells: np.ndarray, cell_name: str) -> tuple[np.ndarray, np.ndarray]:
     """Pairs (a, b) of cells sharing an edge; `cells` in DOLFINx vertex order."""
     edges = _EDGES[cell_name]
-    e = np.sort(np.concatenate([cells[:, list(p)] for p in edges]), axis=1)
+    e = np.sort(np.concatenate([cells[:, list(p)] for p in edges]), axis=1).astype(np.int64)
     owner = np.tile(np.arange(len(cells)), len(edges))
-    _, inv, cnt = np.unique(e, axis=0, return_inverse=True, return_counts=True)
-    inv = inv.ravel()
-    order = np.argsort(inv, kind="stable")
-    shared = cnt[inv[order]] == 2  # interior edges appear twice, consecutively after sorting
+    # an edge as one integer: a sort of keys, not np.unique(axis=0)'s of rows (0.12 s of the
+    # 0.2 s this partition took a step at 100 grains on 2 ranks)
+    key = e[:, 0] * (int(e.max(initial=0)) + 1) + e[:, 1]
+    order = np.argsort(key, kind="stable")
+    _, cnt = np.unique(key[order], return_counts=True)
+    shared = np.repeat(cnt, cnt) == 2  # interior edges appear twice, consecutively after sorting
     pair_start = order[shared][::2], order[shared][1::2]
     return owner[pair_start[0]], owner[pair_start[1]]
 

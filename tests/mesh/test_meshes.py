@@ -17,6 +17,8 @@ from meshes import (  # noqa: E402
     two_blocks_scene,
 )
 from dolfinx_forms.mesh.scene import (
+    _EDGES,
+    _facet_neighbours,
     box_hits,
     cell_bboxes,
     cell_edges,
@@ -374,3 +376,22 @@ def test_scene_builders_refuse_more_cells_than_they_can_hold(module, builder, kw
     make = getattr(importlib.import_module(module), builder)
     with pytest.raises(ValueError, match=f"{builder}: the sizes give"):
         make(MPI.COMM_SELF, **kwargs)
+
+
+@pytest.mark.parametrize("cell_name", ["quadrilateral", "triangle"])
+def test_facet_neighbours_are_the_cells_sharing_an_edge(cell_name):
+    # the partitioner's edge neighbours against a dictionary of edges, on a grid of cells with
+    # shuffled vertex numbers (and, for triangles, each quad split in two)
+    n = 7
+    v = np.random.default_rng(3).permutation((n + 1) ** 2).reshape(n + 1, n + 1)
+    quads = np.array([[v[j, i], v[j, i + 1], v[j + 1, i], v[j + 1, i + 1]]
+                      for j in range(n) for i in range(n)])  # fmt: skip
+    cells = quads if cell_name == "quadrilateral" else np.concatenate([quads[:, :3], quads[:, 1:]])
+    a, b = _facet_neighbours(cells, cell_name)
+    edges = {}
+    for c, cell in enumerate(cells):
+        for p, q in _EDGES[cell_name]:
+            edges.setdefault(tuple(sorted((cell[p], cell[q]))), []).append(c)
+    expected = sorted(tuple(cs) for cs in edges.values() if len(cs) == 2)
+    assert sorted(tuple(sorted(p)) for p in zip(a.tolist(), b.tolist())) == expected
+    assert len(expected) == 2 * n * (n - 1) + (n * n if cell_name == "triangle" else 0)
