@@ -48,40 +48,47 @@ def evolve(sim, problem, scene):
     out = dict(area_levelset={}, advection_substeps={}, reinitialized={}, gradient_drift={})
     sim.grid_increments = {}
     big = np.iinfo(np.int64).max
-    for b in sim.bodies:
+    nb = len(sim.bodies)
+    # known: every node of the body's active cells. The FE increment on the outside nodes of
+    # cut cells is the unfitted method's own (smooth, ghost-penalised) extension, second order
+    # at the interface; the constant normal extension of eq 20 fills the rest of the grid.
+    # (Extending from the inside nodes only would move the interface by du at a node up to h
+    # inside: first order, and the level set would lag the material by ~ h grad(du) per step.)
+    # A window of the grid around the body (its known nodes grown by 6 cells and the step's
+    # largest motion): a grain costs its own size, not the grid's. Beyond it the level set
+    # keeps its (positive, far-field) values. Each reduction serves all bodies at once.
+    lo, hi, umax = np.full((nb, 2), big), np.full((nb, 2), -1), np.zeros(nb)
+    body_dofs = []
+    for k, b in enumerate(sim.bodies):
         dofs = np.unique(cell_dofs[scene.body_cells(b.tag)])
         dofs = dofs[dofs < owned]
-        ib, jb = i[dofs], j[dofs]
-        # known: every node of the body's active cells. The FE increment on the outside
-        # nodes of cut cells is the unfitted method's own (smooth, ghost-penalised)
-        # extension, second order at the interface; the constant normal extension of
-        # eq 20 fills the rest of the grid. (Extending from the inside nodes only would move
-        # the interface by du at a node up to h inside: first order, and the level set
-        # would lag the material by ~ h grad(du) per step.)
-        # A window of the grid around the body (its known nodes grown by 6 cells and the
-        # step's largest motion): a grain costs its own size, not the grid's. Beyond it the
-        # level set keeps its (positive, far-field) values.
-        n = len(dofs) > 0
-        lo = allreduce_array(
-            sim.comm, np.array([ib.min() if n else big, jb.min() if n else big]), MPI.MIN
-        )
-        hi = allreduce_array(
-            sim.comm, np.array([ib.max() if n else -1, jb.max() if n else -1]), MPI.MAX
-        )
-        umax = sim.comm.allreduce(float(np.abs(u[dofs]).max()) if n else 0.0, op=MPI.MAX)
-        m = 6 + int(np.ceil(umax / sim.h))
-        i0, i1 = max(lo[0] - m, 0), min(hi[0] + m, nx - 1)
-        j0, j1 = max(lo[1] - m, 0), min(hi[1] + m, ny - 1)
+        body_dofs.append(dofs)
+        if len(dofs):
+            lo[k], hi[k] = (i[dofs].min(), j[dofs].min()), (i[dofs].max(), j[dofs].max())
+            umax[k] = np.abs(u[dofs]).max()
+    lo, hi = allreduce_array(sim.comm, lo, MPI.MIN), allreduce_array(sim.comm, hi, MPI.MAX)
+    umax = allreduce_array(sim.comm, umax, MPI.MAX)
+    boxes, vs, knowns = [], [], []
+    for k, (b, dofs) in enumerate(zip(sim.bodies, body_dofs)):
+        m = 6 + int(np.ceil(umax[k] / sim.h))
+        i0, i1 = max(lo[k, 0] - m, 0), min(hi[k, 0] + m, nx - 1)
+        j0, j1 = max(lo[k, 1] - m, 0), min(hi[k, 1] + m, ny - 1)
         sim._grow(b.tag, (i0, i1, j0, j1))
-        phi, (a0, _, b0, _) = sim.levelsets[b.tag], sim.windows[b.tag]
         wx, wy = i1 - i0 + 1, j1 - j0 + 1
-        at = (jb - j0) * wx + (ib - i0)
+        at = (j[dofs] - j0) * wx + (i[dofs] - i0)
         v = np.zeros((wy * wx, 2))
         known = np.zeros(wy * wx, np.int8)
         v[at] = u[dofs]
         known[at] = 1
-        v = allreduce_array(sim.comm, v, MPI.SUM)
-        known = allreduce_array(sim.comm, known, MPI.MAX)
+        boxes.append((i0, i1, j0, j1))
+        vs.append(v)
+        knowns.append(known)
+    split = np.cumsum([len(k) for k in knowns])[:-1]
+    vs = np.split(allreduce_array(sim.comm, np.concatenate(vs), MPI.SUM), split)
+    knowns = np.split(allreduce_array(sim.comm, np.concatenate(knowns), MPI.MAX), split)
+    for b, (i0, i1, j0, j1), v, known in zip(sim.bodies, boxes, vs, knowns):
+        phi, (a0, _, b0, _) = sim.levelsets[b.tag], sim.windows[b.tag]
+        wx, wy = i1 - i0 + 1, j1 - j0 + 1
         win = (slice(j0 - b0, j1 - b0 + 1), slice(i0 - a0, i1 - a0 + 1))  # in the body's window
         sub = sim.subgrid((i0, i1, j0, j1))
         values = phi.values  # the body's window, a copy
