@@ -404,6 +404,12 @@ def two_rank_report(comm):
             [],
             0.5,
         )
+    # the second body's cells are made on rank 1: its error still reaches every rank
+    with pytest.raises(ValueError, match="body 'b'.*no active cell"):
+        lines = np.linspace(0, 1, 3)
+        good, bad = half_plane((0, 0.5), (0, 1), 9), half_plane((0, -1), (0, 1), 9)
+        cut_scene(comm, lines, lines, [("a", 1, [[0, 0], [1, 1]], good),
+                                       ("b", 2, [[0, 0], [1, 1]], bad)], {}, [], 0.5)  # fmt: skip
     report = {}
     for name, build in BUILDERS.items():
         s = build(comm)
