@@ -261,19 +261,20 @@ def test_gmsh_left_as_found():
 
 
 def test_box_hits_is_the_scan_of_every_cell():
-    """The partitioner's cells per box by one sort (`box_hits`) are a scan of every cell's
-    bounding box against the box, box by box: cells of two sizes, boxes inside, across, at
-    a cell's edge (closed sets), degenerate and outside."""
+    """The partitioner's cells per box by the broad phase (`box_hits`) are a scan of every
+    cell's bounding box against the box, box by box: cells of two sizes, boxes inside, across,
+    at a cell's edge (closed sets), degenerate, inverted (empty) and outside."""
     rng = np.random.default_rng(3)
     lo = rng.uniform(0, 10, (2000, 2))
     hi = lo + rng.choice([0.1, 0.7], (2000, 1)) * [1.0, 1.3]
     lo[0], hi[0] = [5.0, 5.0], [5.5, 5.5]  # a box touching its edge hits it
-    boxes = [[[4.0, 4.0], [5.0, 6.0]], [[-1, -1], [11, 11]], [[2, 3], [2, 3]], [[20, 0], [21, 1]]]
+    boxes = [[[4.0, 4.0], [5.0, 6.0]], [[-1, -1], [11, 11]], [[2, 3], [2, 3]], [[20, 0], [21, 1]],
+             [[6, 6], [5, 7]]]  # fmt: skip
     boxes = np.vstack([np.array(boxes, float), np.sort(rng.uniform(0, 10, (30, 2, 2)), axis=1)])
     hits = box_hits(lo, hi, boxes)
     for box, hit in zip(boxes, hits):
         assert np.array_equal(hit, np.flatnonzero(np.all((lo <= box[1]) & (hi >= box[0]), 1)))
-    assert 0 in hits[0] and len(hits[1]) == 2000 and len(hits[3]) == 0
+    assert 0 in hits[0] and len(hits[1]) == 2000 and len(hits[3]) == 0 and len(hits[4]) == 0
     assert [len(h) for h in box_hits(lo[:0], hi[:0], boxes[:2])] == [0, 0]
 
 
