@@ -16,12 +16,14 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
-# runs a script and prints its peak resident memory (kB) as the last line of stderr
+# runs a script and prints its peak resident memory (kB) as the last line of stderr, in one
+# write: print()'s pieces, unbuffered (PYTHONUNBUFFERED), interleaved with another rank's lines
+# under mpirun and the benchmark read 0 MB
 WRAP = (
     "import resource, runpy, sys; script = sys.argv[1]; sys.argv = sys.argv[1:]\n"
     "try:\n    runpy.run_path(script, run_name='__main__')\n"
     "except SystemExit as e:\n    code = e.code\nelse:\n    code = 0\n"
-    "print('peak_rss_kb', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, file=sys.stderr)\n"
+    "sys.stderr.write(f'peak_rss_kb {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss}\\n')\n"
     "sys.exit(code)"
 )
 

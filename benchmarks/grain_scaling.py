@@ -74,7 +74,8 @@ def run(grains, ranks, steps, timeout, tmp):
         step=t["total"] / steps,
         **{f"step_{k}": t.get(k, 0.0) / steps for k in PHASES},
         wall=wall,
-        peak_rss_mb=sum(rss) / 1024,
+        # every rank's peak, or None if one did not report it (not a sum that reads 0 MB)
+        peak_rss_mb=sum(rss) / 1024 if len(rss) == ranks else None,
     )
 
 
@@ -142,10 +143,11 @@ def main(argv=None):
     if rows:
         plot(rows, d / "grain_scaling.png")
     for x in rows:
+        mb = x["peak_rss_mb"]
         print(
             f"N = {x['grains']:5d}, {x['ranks']} rank(s): {x['step']:.2f} s/step "
             f"(growth {x['growth']:.2f}, speed-up {x['speedup'] or 0:.2f}), "
-            f"{x['peak_rss_mb']:.0f} MB"
+            + (f"{mb:.0f} MB" if mb is not None else "peak memory not read")
         )
     print(f"results in {d}")
     return 1 if errors else 0
