@@ -220,8 +220,9 @@ def cut_scene(
 
     boundary_markers, pairs, contact_box: as in :func:`dolfinx_forms.mesh.scene.scene_from_gmsh` (no
     contact_box: derived from the pairs and the bodies' bounding boxes, see
-    :func:`dolfinx_forms.mesh.scene.pairs_contact_boxes`; False: DOLFINx's graph partitioner). Rank
-    0 builds the cells and passes them to create_mesh (the other ranks pass empty arrays); the
+    :func:`dolfinx_forms.mesh.scene.pairs_contact_boxes`; False: DOLFINx's graph partitioner). Each
+    rank makes the cells of every size-th body; rank 0 gathers them in the bodies' order and
+    passes them to create_mesh (the other ranks pass empty arrays); the
     body tag and kind of each cell reach the owner and ghosts through
     topology.original_cell_index. ValueError (on every rank) if a window bound is not a grid
     line or a body has no active cell.
