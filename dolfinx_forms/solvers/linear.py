@@ -206,15 +206,31 @@ class Factorised:
     def solve(self, b, x):
         rhs, lifted = self.dirichlet.rhs(self.J, b) if self.symmetric else (b, False)
         self.ksp.solve(rhs, x)
-        reason = self.ksp.getConvergedReason()
-        if reason < 0:
-            raise LinearSolverError(f"linear solver diverged (reason {reason})")
+        if self.ksp.getConvergedReason() < 0:
+            raise LinearSolverError(f"linear solver diverged ({diverged_reason(self.ksp)})")
         self.dirichlet.finish(x, lifted)
 
     def destroy(self):
         destroy(self.ksp, self.A)
         self.dirichlet.destroy()
         self.ksp = self.A = self.J = None
+
+
+def diverged_reason(ksp):
+    """PETSc's reason of a failed solve by name and number; for a failed factorisation also
+    MUMPS's error code INFOG(1) and its detail INFOG(2) (-10: numerically singular, -9: its
+    workspace too small, ...; MUMPS users' guide, section 8), which PETSc reports as
+    DIVERGED_PCSETUP_FAILED alone."""
+    reason = ksp.getConvergedReason()
+    names = {v: k for k, v in vars(PETSc.KSP.ConvergedReason).items() if not k.startswith("_")}
+    text = f"{names.get(reason, 'reason')} {reason}"
+    try:
+        F = ksp.getPC().getFactorMatrix()
+        if F.getType() == "mumps":
+            text += f", MUMPS INFOG(1) = {F.getMumpsInfog(1)}, INFOG(2) = {F.getMumpsInfog(2)}"
+    except PETSc.Error:  # no factor (an iterative solver), or none made
+        pass
+    return text
 
 
 def destroy(*objects):
@@ -503,7 +519,8 @@ class Iterative:
         self.iterations.append(int(its))
         if reason < 0:
             raise LinearSolverError(
-                f"linear solver ({self.krylov} + AMG) diverged (reason {reason}, {its} iterations)"
+                f"linear solver ({self.krylov} + AMG) diverged ({diverged_reason(self.ksp)}, "
+                f"{its} iterations)"
             )
         if self.fresh is None:
             self.fresh = its

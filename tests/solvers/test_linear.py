@@ -293,3 +293,31 @@ def test_tangent_kept_while_its_key_holds(kind, enforcement, monkeypatch):
     assert np.array_equal(kept.u.x.array, ref.u.x.array)
     print(f"tangent assemblies: {counts[0]} kept against {counts[1]}")
     assert counts[0] < counts[1]
+
+
+def test_a_failed_factorisation_names_mumps_error():
+    # a singular matrix (a zero row) factorised by MUMPS: PETSc reports DIVERGED_PCSETUP_FAILED
+    # only; the message adds MUMPS's INFOG(1) = -10 (numerically singular)
+    from petsc4py import PETSc
+
+    A = PETSc.Mat().createAIJ([3, 3], nnz=1, comm=MPI.COMM_SELF)
+    for i, v in ((0, 2.0), (1, 0.0), (2, 3.0)):
+        A.setValue(i, i, v)
+    A.assemble()
+    ksp = PETSc.KSP().create(MPI.COMM_SELF)
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    ksp.getPC().setFactorSolverType("mumps")
+    ksp.setErrorIfNotConverged(False)
+    x, b = A.createVecs()
+    b.set(1.0)
+    try:
+        ksp.solve(b, x)
+    except PETSc.Error:
+        pass
+    assert ksp.getConvergedReason() == PETSc.KSP.ConvergedReason.DIVERGED_PCSETUP_FAILED
+    text = linear.diverged_reason(ksp)
+    assert text.startswith("DIVERGED_PCSETUP_FAILED -11, MUMPS INFOG(1) = -10"), text
+    ksp.destroy()
+    A.destroy()
