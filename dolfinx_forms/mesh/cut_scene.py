@@ -243,7 +243,7 @@ def cut_scene(
         except Exception as e:  # every rank raises (the others would wait in gather)
             failed = (k, isinstance(e, ValueError), str(e), e)
             break
-    failures = [f[:3] for f in comm.allgather(failed and failed[:3]) if f]
+    failures = [f for f in comm.allgather(failed and failed[:3]) if f]  # (body, kind, text)
     if failures:
         k, value_error, message = min(failures)
         if failed is not None and failed[0] == k:
