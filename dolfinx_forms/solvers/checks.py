@@ -49,8 +49,9 @@ RIGID_RTOL = 1e-9
 MIN_NODES = 7  # multiplier nodes with pressure, below which a zone is under-resolved
 
 
-def pair_warnings(g, s, h, band, name):
-    """The warnings of one pair: g its `contact.PairGeometry`, s its committed kernel state."""
+def pair_warnings(g, s, h, band, name, augmented=False):
+    """The warnings of one pair: g its `contact.PairGeometry`, s its committed kernel state,
+    augmented: the enforcement is the augmented Lagrangian."""
     dropped = getattr(g, "dropped", None) or []  # a PairGeometry, or a stand-in in tests
     out = [f"{name}: closest-point projection failed, {d}" for d in dropped]
     active = s["state"] > 0
@@ -58,10 +59,8 @@ def pair_warnings(g, s, h, band, name):
         return out
     pen = -s["g_n"][active].min()
     if pen > PENETRATION * h:
-        out.append(
-            f"{name}: penetration {pen:.3g} = {pen / h:.2g} h exceeds {PENETRATION} h (the "
-            "penalty is too soft for this load: lower eps0, or --enforcement augmented)"
-        )
+        out.append(f"{name}: penetration {pen:.3g} = {pen / h:.2g} h exceeds {PENETRATION} h "
+                   + _penetration_cause(g, s, h, augmented))  # fmt: skip
     near = active & (g.g_n0 > 0.9 * band)
     if near.any():
         out.append(
@@ -90,6 +89,29 @@ def pair_warnings(g, s, h, band, name):
     return out
 
 
+def _penetration_cause(g, s, h, augmented):
+    """Why the points penetrate: the penalty's compliance, or (the augmented Lagrangian's
+    multiplier nodes, traction "points") the P1 trace between nodes whose weighted mean gaps,
+    the quantity its multipliers constrain, are (nearly) closed: at a level-set corner or an
+    edge singularity the pressure varies faster than the nodes can follow (block_compression
+    at 30 %, augmented: 0.11-0.15 h at the platens' corners at h = 0.05 and 0.1, the nodes'
+    gaps within 0.04 h)."""
+    if not (augmented and getattr(g, "law_at_points_with_nodes", False)):
+        return "(the penalty is too soft for this load: lower eps0, or --enforcement augmented)"
+    gbar, carrying = g.project(s["g_n"])[0], g.project(s["tau_n"])[0] < 0
+    node_pen = max(-float(gbar[carrying].min()), 0.0) if np.any(carrying) else 0.0
+    where = (
+        f"at points between the multiplier nodes (their weighted mean gaps, which the augmented "
+        f"Lagrangian constrains, at most {node_pen / h:.2g} h)"
+    )
+    if node_pen > PENETRATION * h:  # what the loop closes is open: not its fixed point
+        return f"{where}: the augmented Lagrangian's constraint is not met"
+    return (
+        f"{where}: the P1 multipliers cannot follow the pressure there (a corner or an edge "
+        "singularity; it shrinks with h)"
+    )
+
+
 def short_gaps(u, active, h):
     """Runs of inactive points between active ones, along the coordinate u, whose active
     neighbours are less than h apart."""
@@ -109,7 +131,9 @@ def contact_warnings(problem):
     mine = []
     for k, (g, s) in enumerate(zip(cs.pairs, cs.committed)):
         if s is not None:
-            mine += pair_warnings(g, s, problem.scene.h_contact, problem.band, "-".join(names[k]))
+            mine += pair_warnings(
+                g, s, problem.scene.h_contact, problem.band, "-".join(names[k]), cs.augmented
+            )
     errors = list(getattr(problem, "band_errors", []))  # the band's growth bound reached
     parts = problem.comm.allgather(mine)
     return errors + [w for part in parts for w in part] + unheld_bodies(problem)

@@ -54,6 +54,27 @@ def test_penetration_and_band():
     assert len(w) == 2 and "penetration" in w[0] and "within 10 % of the band" in w[1]
 
 
+def test_penetration_cause_names_the_enforcement():
+    """The augmented Lagrangian constrains its multiplier nodes' weighted mean gaps, not each
+    point's: a point penetrating between closed nodes is the P1 trace's resolution (a corner,
+    an edge singularity), not a soft penalty; nodes' gaps open too mean its constraint is not
+    met. Two nodes, each the mean of half the points (a stand-in for `PairGeometry.project`)."""
+    n = 8
+    g, s = pair([2] * n)
+    g.law_at_points_with_nodes = True
+    g.project = lambda v: (np.array([np.mean(v[: n // 2]), np.mean(v[n // 2 :])]), None)
+    s["tau_n"] = np.full(n, -1.0)  # every point pressed: both nodes carry pressure
+    s["g_n"] = np.zeros(n)
+    s["g_n"][1] = -1.5 * PENETRATION * H  # one point between nodes whose mean gap is small
+    (w,) = pair_warnings(g, s, H, BAND, "a-b", augmented=True)
+    assert "between the multiplier nodes" in w and "cannot follow" in w and "soft" not in w
+    (w,) = pair_warnings(g, s, H, BAND, "a-b")  # the penalty's reading of the same state
+    assert "the penalty is too soft" in w
+    s["g_n"][:] = -1.5 * PENETRATION * H  # the nodes' mean gaps open as well
+    (w,) = pair_warnings(g, s, H, BAND, "a-b", augmented=True)
+    assert "constraint is not met" in w
+
+
 def hertz(out, *args):
     r = subprocess.run(
         # gmsh's mesh, the figures' (the demo's default is now the layers mesher)
