@@ -225,9 +225,10 @@ class ImplicitMPM:
         return nullcontext() if self.timer is None else self.timer.phase(name)
 
     def snapshot(self):
-        """Every piece of state a step changes (deep copies; the immutable level sets shared)."""
+        """Every piece of state a step changes: the points' arrays and the level sets shared
+        (a step replaces them, never writes into them), the rest copied."""
         return dict(
-            points=None if self.points is None else {t: p.copy() for t, p in self.points.items()},
+            points=None if self.points is None else {t: p.shared() for t, p in self.points.items()},
             levelsets=dict(self.levelsets),  # LevelSets are immutable: shared, not copied
             windows=dict(self.windows),
             obstacles=[ob.state() for ob in self.obstacles],
@@ -239,7 +240,7 @@ class ImplicitMPM:
 
     def restore(self, snap):
         self.points = (
-            None if snap["points"] is None else {t: p.copy() for t, p in snap["points"].items()}
+            None if snap["points"] is None else {t: p.shared() for t, p in snap["points"].items()}
         )
         self.levelsets, self.windows = dict(snap["levelsets"]), dict(snap["windows"])
         for ob, s in zip(self.obstacles, snap["obstacles"]):

@@ -16,12 +16,16 @@ with C the body's linear law (`law_tangent`), and vol <- vol det(I + grad du). A
 therefore rotates the stress instead of creating it, and a rigid translation leaves everything
 but x unchanged (exactly: grad du = 0 there up to round-off).
 
+The arrays of a body's points are replaced at each update, never written in place: a snapshot
+of the state (`ImplicitMPM.snapshot`) shares them (`MaterialPoints.shared`).
+
 Parallel: the points of every body are replicated on all ranks (seeded from the owned cells
 and gathered); the increment at a point is taken from the rank that owns its grid cell.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import basix
@@ -68,24 +72,11 @@ class MaterialPoints:
     def __len__(self):
         return len(self.vol0)
 
-    def copy(self):
-        return MaterialPoints(
-            self.tag,
-            *(
-                a.copy()
-                for a in (
-                    self.x,
-                    self.vol0,
-                    self.vol,
-                    self.stress,
-                    self.F,
-                    self.history,
-                    self.v,
-                    self.a,
-                    self.X,
-                )
-            ),
-        )
+    def shared(self):
+        """Another MaterialPoints over the same arrays. A step replaces these arrays (`update`,
+        `update_finite`, the dynamics' kinematics) and never writes into them, so a snapshot
+        of the points needs no copy (400 grains: 153 MB a step on each rank)."""
+        return dataclasses.replace(self)
 
 
 def law_tangent(law):

@@ -7,6 +7,7 @@ from mpi4py import MPI
 
 import dolfinx_forms as df
 from dolfinx_forms.fem.boundary import Dirichlet
+from dolfinx_forms.fem.laws import NeoHookean
 from dolfinx_forms.geometry.obstacles import RigidObstacle
 from dolfinx_forms.mesh.cut_scene import half_plane
 from dolfinx_forms.mpm.implicit import ImplicitMPM, MPMBody
@@ -18,10 +19,10 @@ COMM = MPI.COMM_SELF
 quiet = dict(log=lambda *a, **k: None)
 
 
-def disc_sim(comm=COMM, steps=10, h=0.5, mu=0.5, **kw):
+def disc_sim(comm=COMM, steps=10, h=0.5, mu=0.5, law=(100e3, 0.3), **kw):
     grid, (name, tag, shape), platens, build = brazilian_disc(comm, 10.0, h, 0.02, steps)
     sym = Dirichlet(lambda x: np.isclose(x[0], 0.0), 0, 0.0)
-    body = MPMBody(name, tag, (100e3, 0.3), shape)
+    body = MPMBody(name, tag, law, shape)
     return ImplicitMPM(
         comm, grid, [body], build, obstacles=platens, dirichlet=[sym], mu=mu, **quiet, **kw
     )
@@ -193,6 +194,26 @@ def test_rejected_step_is_invisible():
     for o, p in zip(sim.obstacles, ref.obstacles):
         assert np.array_equal(o.offset, p.offset) and o.angle == p.angle
     assert r["obstacles"] == r_ref["obstacles"]
+
+
+@pytest.mark.parametrize("law", [(100e3, 0.3), NeoHookean(100e3, 0.3)], ids=["linear", "nh"])
+def test_a_step_replaces_the_point_arrays_and_never_writes_into_them(law):
+    """The snapshot of a step shares the points' arrays (`MaterialPoints.shared`, no copy):
+    the step (small-strain or finite-strain update) must replace them, not write into them,
+    so the snapshot still holds the state before the step, and restoring it gives that
+    state back bitwise."""
+    fields = ("x", "vol0", "vol", "stress", "F", "history", "v", "a", "X")
+    sim = disc_sim(steps=3, law=law)
+    sim.step()
+    snap = sim.snapshot()
+    before = {f: getattr(snap["points"][1], f).copy() for f in fields}
+    sim.step()
+    for f in fields:
+        assert np.array_equal(getattr(snap["points"][1], f), before[f]), f
+    assert not np.array_equal(sim.points[1].x, before["x"])  # the step did move them
+    sim.restore(snap)
+    for f in fields:
+        assert np.array_equal(getattr(sim.points[1], f), before[f]), f
 
 
 def test_each_step_frees_the_problem_it_replaces(monkeypatch):
