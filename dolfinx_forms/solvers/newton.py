@@ -83,6 +83,14 @@ class NewtonOptions:
     al_align: int = 3
     al_align_rtol: float = 1e-2
     al_align_gtol: float = 1e-6
+    # the later solves of an augmented loop start next to the answer: where the tangent
+    # changes with the iterate (a nonlinear bulk, slipping points) they keep the tangent and
+    # factorisation of their first iteration while the active set stays and each iteration
+    # lowers the residual at least al_frozen_rate times (a modified Newton); slower, the
+    # tangent is made afresh for the rest of that solve. block_compression (neo-Hookean, 30 %
+    # in 20 steps, h = 0.05): 415 -> 137 factorisations, 8.2 -> 4.6 s, forces to 7e-11
+    al_frozen: bool = True
+    al_frozen_rate: float = 0.25
 
 
 @dataclass
@@ -124,12 +132,16 @@ def newton(problem, lam, r_ref=0.0, early=0.0, guess=None):
     # take at least one iteration: the multipliers' change is below the step's tolerance
     later = r_ref > 0
     r_base, sig_base, backtracks = None, None, 0  # where the last Newton step started
+    # a later solve keeps its first tangent while it converges where no key says the tangent
+    # is the same (a nonlinear bulk, slipping points: al_frozen)
+    frozen = later and opts.al_frozen
     for it in range(opts.max_iterations + 1):
         predictor = it == 0 and not later and problem.predictor_gap > 0
         guessed = it == 0 and r_zero is not None
         stick = it == 0 and not later and opts.stick_predictor and problem.contact.mu > 0
         # J is assembled once its key is known unless J holds the last keyed tangent (`_keep`)
-        lazy = problem.J_key is not None and not (predictor or stick or problem.bulk.nonlinear)
+        constant = not problem.bulk.nonlinear or frozen  # J depends on the active set only
+        lazy = problem.J_key is not None and not (predictor or stick or not constant)
         r = problem.residual(
             lam, with_tangent=not lazy, predictor=predictor, stick=stick and not guessed
         )
@@ -197,12 +209,19 @@ def newton(problem, lam, r_ref=0.0, early=0.0, guess=None):
             break
         # J is the same matrix (its factorisation reused) for a linear bulk, the same active
         # set, mu and a constant contact tangent (frictionless or no slipping point), no predictor
+        if frozen and r_base is not None and r > opts.al_frozen_rate * r_base:
+            frozen = constant = lazy = False  # too slow on the kept tangent: a fresh one
+            problem.residual(lam, with_tangent=True)  # the same state: R is unchanged
         key = None
-        if not problem.bulk.nonlinear and not predictor and not stick:
+        if constant and not predictor and not stick:
             slip = problem.contact.mu > 0 and problem.comm.allreduce(
                 int(problem.contact.state_counts()[2]), MPI.SUM
             )
-            key = None if slip else (sig, problem.contact.mu, problem.contact.eps_t)
+            same = (sig, problem.contact.mu, problem.contact.eps_t)
+            if not (slip or problem.bulk.nonlinear):
+                key = same  # exactly the same J
+            elif frozen:
+                key = ("kept", *same)  # the first tangent of this active set, kept
         _keep(problem, key, lazy, lam)
         r_base, sig_base, backtracks = r, sig, 0
         # the residual Newton must reach: what an iterative linear solver has to resolve

@@ -560,6 +560,23 @@ def test_augmented_lagrangian_forces_do_not_depend_on_eps0():
         assert forces[1e3][0] > 0
 
 
+def test_augmented_loop_on_a_nonlinear_bulk_keeps_its_tangent():
+    """NewtonOptions.al_frozen: the later solves of an augmented loop on a neo-Hookean disc
+    keep the tangent (and factorisation) of their first iteration while they converge; the
+    platen forces are those of a fresh tangent at every iteration to 1e-8 (both solves to the
+    same tolerance), with fewer factorisations."""
+    forces, fact = {}, {}
+    for frozen in (True, False):
+        sim = disc_sim(steps=3, law=NeoHookean(100e3, 0.3), enforcement="augmented",
+                       newton=NewtonOptions(al_frozen=frozen))  # fmt: skip
+        recs = [sim.step() for _ in range(3)]
+        forces[frozen] = np.array([r["obstacles"]["platen_top"]["fy"] for r in recs])
+        fact[frozen] = sum(r["factorisations"] for r in recs)
+    assert forces[True][0] > 0
+    assert np.allclose(forces[True], forces[False], rtol=1e-8, atol=0)
+    assert fact[True] < 0.6 * fact[False], fact
+
+
 @pytest.mark.parametrize("update", ["flow", "reference-map"])
 def test_each_levelset_update_moves_a_translated_disc(update):
     """A disc translated by 0.3 (3 h) per step through ImplicitMPM: "flow" adds nothing to a
