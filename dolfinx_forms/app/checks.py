@@ -72,3 +72,34 @@ def evaluate_checks(metrics, checks):
         rec.update(value=value, criterion=" and ".join(parts), passed=bool(ok), reason=why)
         out.append(rec)
     return out
+
+
+# warnings of one kind printed in full on the console, the rest counted (all of them stay in
+# metrics.json solver.warnings): 100 grains under the augmented Lagrangian gave 291 lines of
+# "only 2 multiplier nodes carry the contact pressure" in 2 steps, one per pair
+PER_KIND = 3
+_NUMBER = re.compile(r"(?<![A-Za-z_])[-+]?\d+(?:\.\d*)?(?:e[-+]?\d+)?")
+
+
+def warning_kind(text):
+    """A warning without its step, its pair or body name and its numbers ("step 3: a-b: only 2
+    nodes" -> "only # nodes"): what warnings of one kind share."""
+    text = re.sub(r"^step \d+: ", "", text)
+    text = re.sub(r"^[^\s:]+: ", "", text)  # a pair's or body's name (no spaces)
+    return _NUMBER.sub("#", text)
+
+
+def console_warnings(warnings, per_kind=PER_KIND):
+    """The console's lines for `warnings`: "WARNING: " and each, the first per_kind of each
+    kind (`warning_kind`) only, then one line per kind that had more, with their count."""
+    seen, lines = {}, []
+    for w in warnings:
+        k = warning_kind(w)
+        seen[k] = seen.get(k, 0) + 1
+        if seen[k] <= per_kind:
+            lines.append(f"WARNING: {w}")
+    for k, n in seen.items():
+        if n > per_kind:
+            lines.append(f"WARNING: {n - per_kind} more like '{k}' (all in metrics.json "
+                         "solver.warnings)")  # fmt: skip
+    return lines

@@ -25,6 +25,7 @@ handed its scene, problem and stages as functions of the description.
 import sys
 from pathlib import Path
 
+from dolfinx_forms.app.checks import console_warnings
 from dolfinx_forms.io.results import PhaseTimer, new_metrics
 from dolfinx_forms.solvers.newton import ContactSolverError
 
@@ -200,8 +201,8 @@ class Run:
         force = self.params.get("force", False) if force is None else force
         folder = write(self, out, force, **kw)
         if self.rank0:
-            for w in self.metrics.get("solver", {}).get("warnings", []):
-                print(f"WARNING: {w}")
+            for line in console_warnings(self.metrics.get("solver", {}).get("warnings", [])):
+                print(line)
             if summary is not None:
                 print(summary(self) if callable(summary) else summary.format(**self.metrics))
             print(f"results in {folder}")

@@ -303,7 +303,7 @@ def run(spec, out, *, comm, force=False, write=True, log=print):
     from dolfinx_forms.app.demo import Run
     from dolfinx_forms.app.demo import write as write_folder
     from dolfinx_forms.app.mpm_run import Steps
-    from dolfinx_forms.app.checks import RunResult, evaluate_checks
+    from dolfinx_forms.app.checks import RunResult, console_warnings, evaluate_checks
 
     params = dict(spec, out=str(out), force=force)
     with Run(spec["name"], params, discretization="cut", comm=comm, plot=False, prog=PROG,
@@ -322,8 +322,8 @@ def run(spec, out, *, comm, force=False, write=True, log=print):
             evaluate(r, spec)
             r.metrics["checks"] = evaluate_checks(r.metrics, spec["checks"])
             r.metrics["checks_passed"] = all(c["passed"] for c in r.metrics["checks"])
-            for w in r.metrics["solver"]["warnings"]:
-                log(f"WARNING: {w}")
+            for line in console_warnings(r.metrics["solver"]["warnings"]):
+                log(line)
             for c in r.metrics["checks"]:
                 log(f"check {c['label']}: {'ok' if c['passed'] else 'FAILED'} "
                     f"({c['reason'] or c['criterion']})")  # fmt: skip

@@ -24,7 +24,7 @@ import numpy as np
 from mpi4py import MPI
 
 from dolfinx_forms.analysis import analytic, compare
-from dolfinx_forms.app.checks import RunResult, evaluate_checks
+from dolfinx_forms.app.checks import RunResult, console_warnings, evaluate_checks
 from dolfinx_forms.app.description import load
 from dolfinx_forms.app.spec_values import FUNCTIONS, SpecError, make_law
 from dolfinx_forms.solvers import protocol
@@ -309,8 +309,8 @@ def run(
             r.analytic.update(an)
         r.metrics["checks"] = evaluate_checks(r.metrics, spec["checks"])
         r.metrics["checks_passed"] = all(c["passed"] for c in r.metrics["checks"])
-        for w in r.metrics["solver"]["warnings"]:  # as the demos print them
-            log(f"WARNING: {w}")
+        for line in console_warnings(r.metrics["solver"]["warnings"]):  # as the demos do
+            log(line)
         for c in r.metrics["checks"]:
             log(
                 f"check {c['label']}: {'ok' if c['passed'] else 'FAILED'} "
