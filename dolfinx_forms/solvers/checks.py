@@ -89,6 +89,13 @@ def pair_warnings(g, s, h, band, name, augmented=False):
     return out
 
 
+def node_penetration(g, s):
+    """The largest penetration of the multiplier nodes that carry pressure, as their weighted
+    mean gaps (traction "points": what the augmented multipliers constrain); 0 without one."""
+    gbar, carrying = g.project(s["g_n"])[0], g.project(s["tau_n"])[0] < 0
+    return max(-float(gbar[carrying].min()), 0.0) if np.any(carrying) else 0.0
+
+
 def _penetration_cause(g, s, h, augmented):
     """Why the points penetrate: the penalty's compliance, or (the augmented Lagrangian's
     multiplier nodes, traction "points") the P1 trace between nodes whose weighted mean gaps,
@@ -98,8 +105,7 @@ def _penetration_cause(g, s, h, augmented):
     gaps within 0.04 h)."""
     if not (augmented and getattr(g, "law_at_points_with_nodes", False)):
         return "(the penalty is too soft for this load: lower eps0, or --enforcement augmented)"
-    gbar, carrying = g.project(s["g_n"])[0], g.project(s["tau_n"])[0] < 0
-    node_pen = max(-float(gbar[carrying].min()), 0.0) if np.any(carrying) else 0.0
+    node_pen = node_penetration(g, s)
     where = (
         f"at points between the multiplier nodes (their weighted mean gaps, which the augmented "
         f"Lagrangian constrains, at most {node_pen / h:.2g} h)"
@@ -305,9 +311,7 @@ def penetration(problem):
         if np.any(s["state"] > 0):
             pts = max(pts, -float(s["g_n"][s["state"] > 0].min()))
         if g.law_at_points_with_nodes:
-            # traction "points": the multiplier nodes carrying pressure, their mean gaps
-            gbar, active = g.project(s["g_n"])[0], g.project(s["tau_n"])[0] < 0
-            law = max(law, -float(gbar[active].min())) if np.any(active) else law
+            law = max(law, node_penetration(g, s))
         elif np.any(s["law_state"] > 0):
             law = max(law, -float(s["law_g_n"][s["law_state"] > 0].min()))
     h = problem.scene.h_contact
