@@ -88,7 +88,7 @@ class NewtonOptions:
     # factorisation of their first iteration while the active set stays and each iteration
     # lowers the residual at least al_frozen_rate times (a modified Newton); slower, the
     # tangent is made afresh for the rest of that solve. block_compression (neo-Hookean, 30 %
-    # in 20 steps, h = 0.05): 415 -> 137 factorisations, 8.2 -> 4.6 s, forces to 7e-11
+    # in 20 steps, h = 0.05): 415 -> 133 factorisations, 8.5 -> 5.6 s, forces to 7e-11
     al_frozen: bool = True
     al_frozen_rate: float = 0.25
 
