@@ -12,14 +12,23 @@ integrals that differ in their subdomain id only (a law over 100 grains: one per
 keyed by one of them and the ids (`_representatives`): as exact a key, at a tenth of the cost.
 Objects FFCx keys otherwise (coordinate maps) pass through.
 
+An interrupted compile (Ctrl-C, SystemExit) leaves FFCx's claim on its module, the `.c` file in
+the cache, without the `.c.cached` that says it is done: every later run that needs the object
+waited 10 s and stopped with "JIT compilation timed out". FFCx renames the `.c` to `.c.failed`
+when a compile raises an Exception; this memo does the same for the modules this process
+claimed when the compile is interrupted otherwise (`_claims`).
+
 `install()` wraps the process-local compiler under DOLFINx's MPI wrapper, which therefore stays
 collective (rank 0 first, then the others) exactly as before. The application installs it at
 start-up (`app.startup.start`); a script that uses the library alone may call `install()`.
 """
 
 import functools
+import os
+from pathlib import Path
 
 _memo = {}
+_claimed = []  # the .c files of the modules this process is compiling (`_claims`)
 
 
 def _key(ufl_object, form_compiler_params, jit_params):
@@ -67,19 +76,54 @@ def memoised(local_jit):
     def jit(ufl_object, form_compiler_params={}, jit_params={}):
         key = _key(ufl_object, form_compiler_params, jit_params)
         if key is None:
-            return local_jit(ufl_object, form_compiler_params, jit_params)
+            return _compile(local_jit, ufl_object, form_compiler_params, jit_params)
         if key not in _memo:
-            _memo[key] = local_jit(ufl_object, form_compiler_params, jit_params)
+            _memo[key] = _compile(local_jit, ufl_object, form_compiler_params, jit_params)
         return _memo[key]
 
     jit.memo = _memo
     return jit
 
 
+def _compile(local_jit, *args):
+    """local_jit(*args); interrupted by other than an Exception (Ctrl-C), the modules it claimed
+    and did not finish are marked failed, as FFCx marks those of a compile that raised."""
+    del _claimed[:]
+    try:
+        return local_jit(*args)
+    except Exception:
+        raise
+    except BaseException:
+        for c in _claimed:
+            if c.exists() and not c.with_suffix(".c.cached").exists():
+                os.replace(c, c.with_suffix(".c.failed"))
+        raise
+    finally:
+        del _claimed[:]
+
+
+def _claims(get_cached_module):
+    """FFCx's get_cached_module, recording the modules this process claims to compile (it
+    returns (None, None) once it has created their .c file)."""
+
+    @functools.wraps(get_cached_module)
+    def claim(module_name, object_names, cache_dir, timeout):
+        found = get_cached_module(module_name, object_names, cache_dir, timeout)
+        if found == (None, None):
+            _claimed.append(Path(cache_dir).joinpath(module_name).with_suffix(".c"))
+        return found
+
+    claim.claims = True
+    return claim
+
+
 def install():
     """Put the memo under `dolfinx.jit.ffcx_jit` (once per process; later calls do nothing)."""
+    import ffcx.codegeneration.jit as ffcx_jit
     from dolfinx import jit
 
+    if not getattr(ffcx_jit.get_cached_module, "claims", False):
+        ffcx_jit.get_cached_module = _claims(ffcx_jit.get_cached_module)
     if getattr(jit.ffcx_jit, "memoised", False):
         return
     wrapped = jit.mpi_jit_decorator(memoised(jit.ffcx_jit.__wrapped__))

@@ -107,3 +107,27 @@ def test_forms_over_many_ids_keyed_by_their_groups():
     # an integrand that differs (x^3) with the same ids: a new entry
     assert not np.isclose(total(dx2, (1, 2), (3,), deg=3), exact((1, 2), (3,)))
     assert len(memo) == n + 6
+
+
+def test_an_interrupted_compile_leaves_no_claim(tmp_path, monkeypatch):
+    """A compile interrupted by Ctrl-C (KeyboardInterrupt inside FFCx's compiler) leaves its
+    module's .c marked failed, as FFCx marks a compile that raised: the next request compiles
+    it again instead of waiting for the interrupted one and timing out (FFCx's "JIT
+    compilation timed out", after `timeout` seconds; a fresh cache folder here)."""
+    import ffcx.codegeneration.jit as ffcx_jit
+
+    jit_memo.install()
+    m = _square(2, 1.0)
+    x = ufl.SpatialCoordinate(m)
+    a = (x[0] + 2.0 * x[1]) * ufl.dx
+    params = {"cache_dir": str(tmp_path), "timeout": 2}
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    with monkeypatch.context() as patch:
+        patch.setattr(ffcx_jit, "_compile_objects", interrupted)
+        with pytest.raises(KeyboardInterrupt):
+            fem.form(a, jit_params=params)
+    assert list(tmp_path.glob("*.c")) == [] and len(list(tmp_path.glob("*.c.failed"))) == 1
+    assert np.isclose(_total(fem.form(a, jit_params=params)), 1.5)  # int x + 2 y = 1/2 + 1
