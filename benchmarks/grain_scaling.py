@@ -86,11 +86,12 @@ def plot(rows, path):
     import matplotlib.pyplot as plt
 
     fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4))
-    for r in sorted({x["ranks"] for x in rows}):
+    ranks = sorted({x["ranks"] for x in rows})
+    for r in ranks:
         sel = sorted((x for x in rows if x["ranks"] == r), key=lambda x: x["grains"])
         n = [x["grains"] for x in sel]
         a.loglog(n, [x["step"] for x in sel], "o-", label=f"{r} rank(s)")
-        if r == 1 and sel:
+        if r == ranks[0] and sel:  # the phases of the fewest ranks run (a 2-rank run alone)
             a.loglog(n, [sel[0]["step"] * k / n[0] for k in n], "k:", label="linear in N")
             bottom = [0.0] * len(sel)
             for k in PHASES:
@@ -100,7 +101,7 @@ def plot(rows, path):
     a.set_xlabel("grains N")
     a.set_ylabel("seconds per compression step")
     a.legend()
-    b.set_xlabel("grains N (1 rank)")
+    b.set_xlabel(f"grains N ({ranks[0] if ranks else 1} rank(s))")
     b.set_ylabel("seconds per step, by phase")
     b.legend(fontsize=7)
     fig.tight_layout()
