@@ -1,9 +1,12 @@
 """Small helpers shared by the library's sub-packages: MPI reductions of arrays, the running
-program's name (for one-line messages), the threads a rank may use and the error of a bad scene
-description."""
+program's name (for one-line messages), the threads a rank may use, the error of a bad scene
+description and the signals that unwind (a block's clean-up runs when it is interrupted)."""
 
 import os
+import signal
 import sys
+import threading
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -49,3 +52,28 @@ class SpecError(ValueError):
     def __init__(self, key, message):
         self.key = key
         super().__init__(f"{key}: {message}")
+
+
+@contextmanager
+def signals_unwind():
+    """Within the block (main thread only), SIGINT raises KeyboardInterrupt and SIGTERM
+    SystemExit(143) where the handler is the default action, so the block's clean-up runs (a
+    result folder's temporary folder is removed, a JIT compile's claim released): importing
+    gmsh (also through dolfinx.io.gmshio) sets SIGINT's handler to the default action, and only
+    gmsh.finalize restores it. Other handlers are left alone (an enclosing block's too)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def term(signum, frame):
+        raise SystemExit(128 + signum)
+
+    handlers = {signal.SIGINT: signal.default_int_handler, signal.SIGTERM: term}
+    ours = [s for s in handlers if signal.getsignal(s) is signal.SIG_DFL]
+    for s in ours:
+        signal.signal(s, handlers[s])
+    try:
+        yield
+    finally:
+        for s in ours:
+            signal.signal(s, signal.SIG_DFL)

@@ -12,11 +12,17 @@ integrals that differ in their subdomain id only (a law over 100 grains: one per
 keyed by one of them and the ids (`_representatives`): as exact a key, at a tenth of the cost.
 Objects FFCx keys otherwise (coordinate maps) pass through.
 
-An interrupted compile (Ctrl-C, SystemExit) leaves FFCx's claim on its module, the `.c` file in
-the cache, without the `.c.cached` that says it is done: every later run that needs the object
-waited 10 s and stopped with "JIT compilation timed out". FFCx renames the `.c` to `.c.failed`
-when a compile raises an Exception; this memo does the same for the modules this process
-claimed when the compile is interrupted otherwise (`_claims`).
+An interrupted compile leaves FFCx's claim on its module, the `.c` file in the cache, without
+the `.c.cached` that says it is done: every later run that needs the object waited 10 s and
+stopped with "JIT compilation timed out". FFCx renames the `.c` to `.c.failed` when a compile
+raises an Exception; this module does the same
+- for the modules this process claimed when the compile is interrupted otherwise (Ctrl-C,
+  SystemExit, and SIGTERM, which raises SystemExit(143) during a compile: `_compile`);
+- for a claim whose process is gone (SIGKILL, a crash: `_release_stale`): each claim of this
+  process names its owner (host and pid) in a `.c.owner` file beside the `.c` until the compile
+  ends; a claim whose owner is not running on this host, or an unnamed one unchanged for
+  STALE_AGE, is released and the module compiled afresh. A live owner's claim is waited for
+  as before.
 
 `install()` wraps the process-local compiler under DOLFINx's MPI wrapper, which therefore stays
 collective (rank 0 first, then the others) exactly as before. The application installs it at
@@ -25,10 +31,18 @@ start-up (`app.startup.start`); a script that uses the library alone may call `i
 
 import functools
 import os
+import socket
+import time
 from pathlib import Path
+
+from dolfinx_forms.common import signals_unwind
 
 _memo = {}
 _claimed = []  # the .c files of the modules this process is compiling (`_claims`)
+# a claim without an owner file (FFCx alone, or an older version of this module) is taken for
+# abandoned once its .c is this old (s): FFCx rewrites the .c with the module's source when it
+# compiles, and the largest forms here compile in well under a minute
+STALE_AGE = 3600.0
 
 
 def _key(ufl_object, form_compiler_params, jit_params):
@@ -86,11 +100,13 @@ def memoised(local_jit):
 
 
 def _compile(local_jit, *args):
-    """local_jit(*args); interrupted by other than an Exception (Ctrl-C), the modules it claimed
-    and did not finish are marked failed, as FFCx marks those of a compile that raised."""
+    """local_jit(*args); interrupted by other than an Exception (Ctrl-C, SIGTERM), the modules it
+    claimed and did not finish are marked failed, as FFCx marks those of a compile that raised.
+    Their owner files go either way."""
     del _claimed[:]
     try:
-        return local_jit(*args)
+        with signals_unwind():
+            return local_jit(*args)
     except Exception:
         raise
     except BaseException:
@@ -99,22 +115,73 @@ def _compile(local_jit, *args):
                 os.replace(c, c.with_suffix(".c.failed"))
         raise
     finally:
+        for c in _claimed:
+            _remove(c.with_suffix(".c.owner"))
         del _claimed[:]
 
 
 def _claims(get_cached_module):
     """FFCx's get_cached_module, recording the modules this process claims to compile (it
-    returns (None, None) once it has created their .c file)."""
+    returns (None, None) once it has created their .c file) with an owner file beside each, and
+    releasing an abandoned claim first (`_release_stale`)."""
 
     @functools.wraps(get_cached_module)
     def claim(module_name, object_names, cache_dir, timeout):
+        c = Path(cache_dir).joinpath(module_name).with_suffix(".c")
+        _release_stale(c)
         found = get_cached_module(module_name, object_names, cache_dir, timeout)
         if found == (None, None):
-            _claimed.append(Path(cache_dir).joinpath(module_name).with_suffix(".c"))
+            _claimed.append(c)
+            c.with_suffix(".c.owner").write_text(f"{socket.gethostname()} {os.getpid()}\n")
         return found
 
     claim.claims = True
     return claim
+
+
+def _release_stale(c):
+    """Mark the claim `c` (a module's .c in FFCx's cache) failed if its compile was abandoned:
+    not done (no .c.cached) and its owner (the .c.owner file: host and pid) not running on this
+    host, or, without an owner file, the .c unchanged for STALE_AGE seconds. The next claim then
+    compiles the module afresh, as after a compile that raised. A claim of another host, or of a
+    running process, is left to FFCx's wait."""
+    try:
+        if c.with_suffix(".c.cached").exists():
+            return
+        age = c.stat().st_mtime
+    except FileNotFoundError:
+        return
+    owner = c.with_suffix(".c.owner")
+    try:
+        host, pid = owner.read_text().split()
+    except (FileNotFoundError, ValueError):
+        if time.time() - age < STALE_AGE:
+            return
+    else:
+        if host != socket.gethostname() or _running(int(pid)):
+            return
+    try:
+        os.replace(c, c.with_suffix(".c.failed"))
+    except FileNotFoundError:  # another process released it first
+        pass
+    _remove(owner)
+
+
+def _running(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
+def _remove(path):
+    try:
+        path.unlink()
+    except FileNotFoundError:
+        pass
 
 
 def install():

@@ -35,6 +35,8 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
+from dolfinx_forms.common import signals_unwind
+
 MARKER = ".ils_result"
 # names the programs of this repository write at the top of a result folder: with --force a
 # foreign entry of one of these names is refused when the arguments are parsed
@@ -340,30 +342,6 @@ def _signals_blocked():
 
 
 @contextmanager
-def _signals_unwind():
-    """While the results are written (main thread only), SIGINT raises KeyboardInterrupt and
-    SIGTERM SystemExit(143) where the handler is the default action, so the temporary folder is
-    removed: importing gmsh (also through dolfinx.io.gmshio) sets SIGINT's handler to the
-    default action, and only gmsh.finalize restores it. Other handlers are left alone."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def term(signum, frame):
-        raise SystemExit(128 + signum)
-
-    handlers = {signal.SIGINT: signal.default_int_handler, signal.SIGTERM: term}
-    ours = [s for s in handlers if signal.getsignal(s) is signal.SIG_DFL]
-    for s in ours:
-        signal.signal(s, handlers[s])
-    try:
-        yield
-    finally:
-        for s in ours:
-            signal.signal(s, signal.SIG_DFL)
-
-
-@contextmanager
 def atomic_output_dir(out, comm=None, force=False, program=None):
     """Yield a temporary folder beside `out`, shared by all ranks of `comm` (default
     COMM_WORLD), which becomes `out` when the block succeeded on every rank (rules in the
@@ -380,7 +358,7 @@ def atomic_output_dir(out, comm=None, force=False, program=None):
     program = program or program_name()
     tmp = None
     try:  # from the temporary folder's creation until every rank has written into it
-        with _signals_unwind():
+        with signals_unwind():
             status = None
             if comm.rank == 0:
                 try:

@@ -2,6 +2,13 @@
 reused across meshes, and never shared by forms that differ (different constants, spaces,
 quadrature degrees). Also under mpirun -n 2: the memo sits under DOLFINx's collective wrapper."""
 
+import os
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
 import numpy as np
 import pytest
 import ufl
@@ -131,3 +138,96 @@ def test_an_interrupted_compile_leaves_no_claim(tmp_path, monkeypatch):
             fem.form(a, jit_params=params)
     assert list(tmp_path.glob("*.c")) == [] and len(list(tmp_path.glob("*.c.failed"))) == 1
     assert np.isclose(_total(fem.form(a, jit_params=params)), 1.5)  # int x + 2 y = 1/2 + 1
+
+
+def _claim_test_form():
+    m = _square(2, 1.0)
+    x = ufl.SpatialCoordinate(m)
+    return (x[0] + 2.0 * x[1]) * ufl.dx
+
+
+def _claims_of(tmp_path, a):
+    """The .c files (FFCx's module claims) of form `a`'s modules, from a compile in a cache of
+    their own."""
+    seen = tmp_path / "seen"
+    fem.form(a, jit_params={"cache_dir": str(seen), "timeout": 2})
+    return sorted(p.name for p in seen.glob("*.c"))
+
+
+def test_an_abandoned_claim_is_compiled_afresh(tmp_path):
+    """A claim left by a process that is gone (killed by SIGKILL, crashed: its .c without the
+    .c.cached of a finished compile) is released and the module compiled afresh, whether its
+    owner file names a process that no longer runs or, without one, it is older than
+    STALE_AGE. A claim of a running process, or a fresh unnamed one, is waited for as FFCx does
+    (and times out here after `timeout` seconds)."""
+    jit_memo.install()
+    a = _claim_test_form()
+    names = _claims_of(tmp_path, a)
+    assert names
+    gone = subprocess.Popen(["true"])
+    gone.wait()  # its pid names no running process (a reused pid would only mean a wait)
+    live = subprocess.Popen(["sleep", "60"])
+    host = socket.gethostname()
+    try:
+        cases = {
+            "gone": (f"{host} {gone.pid}", 0.0, True),
+            "old": (None, 2 * jit_memo.STALE_AGE, True),
+            "live": (f"{host} {live.pid}", 0.0, False),
+            "fresh": (None, 0.0, False),
+        }
+        for name, (owner, age, released) in cases.items():
+            cache = tmp_path / name
+            cache.mkdir()
+            for n in names:
+                c = cache / n
+                c.touch()
+                os.utime(c, (time.time() - age,) * 2)
+                if owner:
+                    c.with_suffix(".c.owner").write_text(owner + "\n")
+            params = {"cache_dir": str(cache), "timeout": 2}
+            if released:
+                assert np.isclose(_total(fem.form(a, jit_params=params)), 1.5), name
+                assert len(list(cache.glob("*.c.cached"))) == len(names), name
+                assert list(cache.glob("*.c.owner")) == [], name
+            else:
+                with pytest.raises(TimeoutError):
+                    fem.form(a, jit_params=params)
+    finally:
+        live.kill()
+        live.wait()
+
+
+SIGTERM_SCRIPT = """
+import os, signal, sys, time
+import ffcx.codegeneration.jit as ffcx_jit
+import ufl
+from dolfinx import fem, mesh
+from mpi4py import MPI
+from dolfinx_forms.fem import jit_memo
+
+jit_memo.install()
+
+def terminated(*args, **kwargs):
+    os.kill(os.getpid(), signal.SIGTERM)
+    time.sleep(30)
+
+ffcx_jit._compile_objects = terminated
+m = mesh.create_unit_square(MPI.COMM_WORLD, 2, 2, mesh.CellType.quadrilateral)
+x = ufl.SpatialCoordinate(m)
+fem.form((x[0] + 3.0 * x[1]) * ufl.dx, jit_params={"cache_dir": sys.argv[1]})
+"""
+
+
+def test_a_compile_ended_by_sigterm_leaves_no_claim(tmp_path):
+    """SIGTERM during a compile (mpirun ending its ranks, a batch system's time limit) ends the
+    process with status 143 and marks the module's claim failed, its owner file removed, as
+    Ctrl-C does: the next run compiles it instead of timing out."""
+    cache = tmp_path / "cache"
+    env = {**os.environ, "PYTHONPATH": str(Path(jit_memo.__file__).parents[2])}
+    run = subprocess.run(
+        [sys.executable, "-c", SIGTERM_SCRIPT, str(cache)], env=env, capture_output=True,
+        text=True, timeout=120,
+    )  # fmt: skip
+    assert run.returncode == 143, run.stderr[-2000:]
+    assert list(cache.glob("*.c")) == [] and list(cache.glob("*.c.owner")) == []
+    assert len(list(cache.glob("*.c.failed"))) == 1
