@@ -75,6 +75,22 @@ MAX_BAND_GROWTH = 4  # doublings of the contact band within one step (16 times t
 # halvings of a failed quasi-static step (`ImplicitMPM.step`): down to an eighth of it. The
 # neo-Hookean block of block_compression.py failed at 34 % in 20 steps and ran in 40.
 MAX_SPLITS = 3
+# the augmented Lagrangian's point-wise regularisation eps_n (traction "points", the lumped
+# projection: 2 h / E_c, `defaults.TUNING.pointwise_eps0`) times this on bodies at finite
+# strain. Where the pressure peaks within a multiplier element (a platen's corner) the points
+# penetrate by eps_n (tau - lambda_h), proportional to eps_n: 0.107 h at the neo-Hookean
+# block's corners at 32 % (block_compression.py, h = 0.05; the penalty at eps0 0.1: 0.041 h).
+# The corner, compressed to det F 0.65-0.75 beside the penetrated rim, then loses the stiffness
+# of its sideways mode: at step 17 (34 %) the tangent's softest eigenvalue was 1.2 of 8.2e3 at
+# the step's start and -0.19 after the first Newton iterate (bulk -1.60, contact +1.29, ghost
+# penalty +0.12), and Newton moved the corner nodes by 1.3 mm (det F <= 0), at every split of
+# the step. The 40 % run in 20 steps failed at step 17 / 18 / 19 with factors 1 / 0.5 / 0.25
+# and completes with 0.1 (as the penalty does at eps0 0.1: eps 0.1 h / E_c). Measured there:
+# corner penetration 0.13 -> 0.02 h at 32 %; force error at 30 %: 0.81 -> 1.38 % (neo-Hookean),
+# 0.82 -> 1.37 % (J2), with 12 instead of 29 (43) Newton iterations per step. J2 at 40 % then
+# folded points beside a top corner (det f <= 0 at 4 points in step 18): `_step` rejects such
+# an increment, and the step is split
+FINITE_STRAIN_REGULARISATION = 0.1
 # step-record counters that add up over a step's sub-steps (the rest: the last sub-step's)
 _SUMMED = ("newton_iterations", "cutbacks", "factorisations", "coupling_rebuilds",
            "mls_widened", "mls_F_nearest", "wall_s", "predicted")  # fmt: skip
@@ -205,6 +221,8 @@ class ImplicitMPM:
             # the lumped projection of the multipliers: with the hybrid one (the single-step
             # default) the grain assembly's Newton cycles from its second step on
             problem_kw.setdefault("multiplier_mass", "lumped")
+            if self.point_laws:  # a finite-strain body: the stiffer eps_n (see the constant)
+                problem_kw.setdefault("regularisation", FINITE_STRAIN_REGULARISATION)
         options(**problem_kw)  # an unknown option fails here, not at the first step
         self.problem_kw = problem_kw
         # the contact band (the largest initial gap Gamma_c covers): the given one or 2 h to
@@ -410,9 +428,21 @@ class ImplicitMPM:
         with self.phase("points"):
             outside = 0
             moved = []
+            at = {b.tag: mp.displacement_at(problem, b.tag, self.points[b.tag].x, self.h)
+                  for b in self.bodies}  # fmt: skip
+            for b in self.bodies:  # a folded point (det f <= 0): the step is rejected (split)
+                bad = np.zeros(0, int)
+                if b.tag in self.point_laws:
+                    bad = np.flatnonzero(mp.det2(np.eye(2) + at[b.tag][1]) <= 0)
+                if len(bad):
+                    x = self.points[b.tag].x[bad[0]]
+                    raise ContactSolverError(
+                        f"{label}: the increment folds {len(bad)} point(s) of body {b.name!r} "
+                        f"(det(I + grad du) <= 0; one at ({x[0]:.4g}, {x[1]:.4g}))"
+                    )
             for b in self.bodies:
                 pts = self.points[b.tag]
-                du, grad, n_out = mp.displacement_at(problem, b.tag, pts.x, self.h)
+                du, grad, n_out = at[b.tag]
                 if self.dynamics is not None:
                     self.dynamics.update(pts, du)
                 if b.tag in self.point_laws:

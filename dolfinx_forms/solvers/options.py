@@ -34,7 +34,9 @@ class ContactOptions:
     through (symmetric scenes stay symmetric). predictor_gap: in a step's first Newton
     iteration, open points with a gap below it add a closed point's tangent (no force; holds
     bodies whose contacts touch but are not closed yet). contact_rank: the rank that holds
-    Gamma_c's cells (contact_box partitioning)."""
+    Gamma_c's cells (contact_box partitioning). regularisation: the augmented Lagrangian's
+    point-wise eps_n (traction "points") times this: 1 the tuned one (`defaults.TUNING`), below
+    1 stiffer (the MPM's bodies at finite strain: `mpm.implicit.FINITE_STRAIN_REGULARISATION`)."""
 
     mu: float = 0.0
     eps0: float = 1.0
@@ -50,6 +52,7 @@ class ContactOptions:
     pair_grid_origin: object = None
     predictor_gap: float = 0.0
     contact_rank: int = 0
+    regularisation: float = 1.0
 
 
 @dataclass

@@ -581,7 +581,7 @@ def enforcement(c, h, E_c, cut):
     tune = defaults.TUNING
     if augmented and multipliers is not None and traction == "points":
         k_n = tune.consistent_eps0 if consistent else tune.pointwise_eps0
-        fine = penalty_parameter(k_n, h, E_c)
+        fine = penalty_parameter(k_n, h, E_c) * float(c.regularisation)
         out.update(eps_n=fine, relaxation=min(1.0, fine / eps))
         out["eps_t"] = out["eps_t_start"] = penalty_parameter(tune.pointwise_eps0_t, h, E_c)
         if consistent:

@@ -39,3 +39,21 @@ def test_tuning_is_read_when_a_problem_is_made(monkeypatch):
     twice = dataclasses.replace(t, consistent_eps0=2 * t.consistent_eps0)
     monkeypatch.setattr(defaults, "TUNING", twice)
     assert problem().eps_n == pytest.approx(2 * before.eps_n, rel=1e-12)
+
+
+def test_regularisation_scales_the_augmented_eps_n_only():
+    """ContactOptions.regularisation multiplies the augmented Lagrangian's point-wise eps_n
+    (the MPM's finite-strain bodies take 0.1 of it); the penalty's eps (eps0 h / E_c) and the
+    tangential eps_t are the user's / the tuned ones whatever it is."""
+    scene = patch_cut_scene(MPI.COMM_SELF, n=4, interface=0.6)
+    laws = {b.tag: (1.0, 0.3) for b in scene.bodies}
+
+    def problem(**kw):
+        bcs = patch_dirichlet(0.01)
+        return ContactProblem(scene, laws, dirichlet=bcs, **options(band=0.1, **kw))
+
+    tuned, stiff = (problem(enforcement="augmented", regularisation=r) for r in (1.0, 0.1))
+    assert stiff.eps_n == pytest.approx(0.1 * tuned.eps_n, rel=1e-12)
+    assert stiff.contact.eps_t == tuned.contact.eps_t
+    penalty = [problem(eps0=0.5, regularisation=r).eps_n for r in (1.0, 0.1)]
+    assert penalty[0] == penalty[1]
