@@ -15,8 +15,9 @@ in brackets; lengths and forces in the scene's units, angles in degrees):
       [4], num_gauss [2], linear_solver ["auto"], petsc {KEY = VALUE}, newton {rtol, ftol,
       atol, stol, max_iterations, max_cutbacks}, predictor_gap [0], levelset_update
       ["advection"], "flow" or "reference-map" (mpm/evolution.py), reinit_drift [0.2],
-      extrapolate [true] (a quasi-static step's Newton starts from the last step's increment
-      where that lowers its first residual: mpm/increment.py)
+      extrapolate [true, false where a law carries a history] (a quasi-static step's Newton
+      starts from the last step's increment where that lowers its first residual:
+      mpm/increment.py)
   [dynamics]  (optional: inertia, each stage step a time step; mpm/dynamics.py PointNewmark)
       dt, integrator ["dissipative"] or "trapezoidal", gravity [[0, 0]] (per unit mass),
       viscosity [0] (Kelvin-Voigt eta: spares rigid motions), mass_damping [0] (Rayleigh's
@@ -131,7 +132,7 @@ def _solver(t):
             "levelset_update", LEVELSET_UPDATES[0], choices=list(LEVELSET_UPDATES)
         ),
         reinit_drift=t.number("reinit_drift", 0.2, lo=0, lo_open=True),
-        extrapolate=t.boolean("extrapolate", True),
+        extrapolate=t.boolean("extrapolate", None),  # None: ImplicitMPM's choice
         linear_solver=t.string(
             "linear_solver", "auto", choices=["auto", "condensed", "factorised", "iterative"]
         ),

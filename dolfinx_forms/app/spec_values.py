@@ -205,6 +205,8 @@ class Table:
 
     def boolean(self, k, default=REQUIRED):
         v = self.raw(k, default)
+        if v is None and default is None:  # absent: the program chooses
+            return None
         if not isinstance(v, bool):
             raise SpecError(self.path(k), f"must be true or false, got {v!r}")
         return v

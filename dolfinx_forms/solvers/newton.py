@@ -45,6 +45,22 @@ class NewtonOptions:
     # the grain assembly 7.8 instead of 7.9, all with the same answers
     stick_predictor: bool = True
     max_backtracks: int = 5
+    # on a nonlinear bulk, a step that changes the active set and raises the residual above
+    # rise_limit times the lowest residual of the solve so far is halved like one that keeps it
+    # (None: inf, steps across a change taken whole, except on the material-point path, whose
+    # problems take mpm.implicit.RISE_LIMIT = 1). Finite-strain J2 with friction
+    # (demos/disc_crush.py, the MPM): whole steps across changes of the contact set on a soft
+    # plastic zone raised the residual from 35 to 1e7 in 20 iterations (|du| 8 h an iteration;
+    # the tangent is the consistent one, to 1e-9 against differences) and failed perfect
+    # plasticity (h = 1, 16 steps, yield 10, H = 0 and 1) at step 8-9 and the default J2 (H =
+    # 100, h = 0.4) at step 24; with rise_limit = 1 all three complete (11 Newton iterations
+    # instead of 31 with cut-backs at the first step), the neo-Hookean crush and the J2 block
+    # give the same forces (2e-12). A linear bulk keeps whole steps: with penalty contact its
+    # problem is piecewise linear and they end the semismooth Newton in a few iterations (Hertz
+    # under force control: 10-16 iterations instead of <= 6 when halved). The body-fitted J2
+    # reference at H = 0 (h = 0.5 and 1, 16 steps) needs whole steps: at 1 it stalls at 1e-5 of a
+    # solve's first residual, where its active set settles through rising steps
+    rise_limit: float | None = None
     # augmented Lagrangian (Uzawa): stop when no multiplier changes by more than al_rtol of
     # the largest traction *and* no gap by more than al_gtol h (the change of a multiplier is
     # the gap over eps: a soft eps converges slowly, with small changes far from the answer);
@@ -132,6 +148,7 @@ def newton(problem, lam, r_ref=0.0, early=0.0, guess=None):
     # take at least one iteration: the multipliers' change is below the step's tolerance
     later = r_ref > 0
     r_base, sig_base, backtracks = None, None, 0  # where the last Newton step started
+    r_low = np.inf  # the lowest residual a Newton step started from (rise_limit)
     # a later solve keeps its first tangent while it converges where no key says the tangent
     # is the same (a nonlinear bulk, slipping points: al_frozen)
     frozen = later and opts.al_frozen
@@ -194,9 +211,13 @@ def newton(problem, lam, r_ref=0.0, early=0.0, guess=None):
         # Line search: a step that keeps the active set but does not lower the residual (the
         # slip law's curvature) is halved, u = u_base + alpha du. A step that changes the active
         # set is taken whole: the semismooth Newton's residual need not fall monotonically;
-        # unless it jumped back to an active set seen before (a cycle, damp_cycles): halved too,
+        # unless, on a nonlinear bulk, it raises the residual above rise_limit times the solve's
+        # lowest (a divergence through ever-changing active sets: a plastic zone's soft tangent),
+        # or it jumped back to an active set seen before (a cycle, damp_cycles): halved too,
         # across the change, before giving up
-        worse = opts.line_search and r_base is not None and r > r_base and sig == sig_base
+        rise_limit = np.inf if opts.rise_limit is None else opts.rise_limit
+        rise = sig == sig_base or (problem.bulk.nonlinear and r > rise_limit * r_low)
+        worse = opts.line_search and r_base is not None and r > r_base and rise
         if worse or (cycling and opts.damp_cycles and r_base is not None):
             if backtracks < opts.max_backtracks and it < opts.max_iterations:
                 backtracks += 1
@@ -224,6 +245,7 @@ def newton(problem, lam, r_ref=0.0, early=0.0, guess=None):
                 key = ("kept", *same)  # the first tangent of this active set, kept
         _keep(problem, key, lazy, lam)
         r_base, sig_base, backtracks = r, sig, 0
+        r_low = min(r_low, r)
         # the residual Newton must reach: what an iterative linear solver has to resolve
         problem.linear.newton_target = max(opts.rtol * r0, opts.ftol * problem.force_scale)
         with problem.phase("solve"):

@@ -784,3 +784,22 @@ def test_an_mpm_step_factorises_with_the_short_lived_ordering(monkeypatch):
     user.step()
     assert user.problem.linear.ordering is None  # the user's choice stands
     assert used == [SHORT_LIVED_ORDERING, 4]  # PORD
+
+
+def test_the_path_chooses_the_newton_start_and_the_rise_limit():
+    """ImplicitMPM's defaults where the user leaves them (None): a quasi-static step starts
+    from the last increment unless a body's law carries a history (J2: from du = 0, fewer
+    Newton iterations: `implicit.EXTRAPOLATE_HISTORY`), and Newton halves a step that raises
+    the residual across an active-set change (`implicit.RISE_LIMIT`); a user's choice stands."""
+    from dolfinx_forms.fem.plasticity import J2Plasticity
+    from dolfinx_forms.mpm import implicit
+
+    j2 = J2Plasticity(100e3, 0.3, 200.0, 100.0)
+    assert disc_sim(law=(100e3, 0.3)).extrapolate
+    assert disc_sim(law=NeoHookean(100e3, 0.3)).extrapolate
+    assert not disc_sim(law=j2).extrapolate
+    assert disc_sim(law=j2, extrapolate=True).extrapolate
+    assert disc_sim().problem_kw["newton"].rise_limit == implicit.RISE_LIMIT == 1.0
+    mine = disc_sim(newton=NewtonOptions(rise_limit=np.inf)).problem_kw["newton"]
+    assert mine.rise_limit == np.inf
+    assert NewtonOptions().rise_limit is None  # elsewhere: steps across a change taken whole
