@@ -15,14 +15,12 @@ from meshes.mpm import cylinder_on_floor
 def cylinder(dt, damp_cycles=False):
     """A coarse neo-Hookean cylinder released on a floor under gravity turned by 30 degrees,
     the dissipative rule: its first step fails at dt = 0.1 (the contact's active set cycles)
-    unless Newton damps the cycle or halves the steps that raise the residual across a change of
-    the active set (NewtonOptions.damp_cycles, rise_limit = 1: the defaults elsewhere)."""
+    unless Newton damps the cycle (NewtonOptions.damp_cycles, the default elsewhere)."""
     grid, (name, tag, shape), floor, build = cylinder_on_floor(MPI.COMM_SELF, 1.0, 0.2, 2.0)
     dyn = PointNewmark({tag: 1.0}, dt, "dissipative", gravity=(0.5, -np.sqrt(0.75)))
     sim = ImplicitMPM(MPI.COMM_SELF, grid, [MPMBody(name, tag, NeoHookean(1e4, 0.3), shape)],
                       build, obstacles=[floor], dynamics=dyn, mu=0.5,
-                      newton=NewtonOptions(damp_cycles=damp_cycles,
-                                           rise_limit=1.0 if damp_cycles else np.inf),
+                      newton=NewtonOptions(damp_cycles=damp_cycles),
                       log=lambda *a, **k: None)  # fmt: skip
     return sim, dyn
 

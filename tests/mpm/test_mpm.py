@@ -789,10 +789,12 @@ def test_an_mpm_step_factorises_with_the_short_lived_ordering(monkeypatch):
 def test_the_path_chooses_the_newton_start_and_the_rise_limit():
     """ImplicitMPM's defaults where the user leaves them (None): a quasi-static step starts
     from the last increment unless a body's law carries a history (J2: from du = 0, fewer
-    Newton iterations: `implicit.EXTRAPOLATE_HISTORY`), and Newton halves a step that raises
-    the residual across an active-set change (`implicit.RISE_LIMIT`); a user's choice stands."""
+    Newton iterations: `implicit.EXTRAPOLATE_HISTORY`), and a quasi-static step's Newton halves a
+    step that raises the residual across an active-set change (`implicit.RISE_LIMIT`; not in
+    dynamics); a user's choice stands."""
     from dolfinx_forms.fem.plasticity import J2Plasticity
     from dolfinx_forms.mpm import implicit
+    from dolfinx_forms.mpm.dynamics import PointNewmark
 
     j2 = J2Plasticity(100e3, 0.3, 200.0, 100.0)
     assert disc_sim(law=(100e3, 0.3)).extrapolate
@@ -802,4 +804,6 @@ def test_the_path_chooses_the_newton_start_and_the_rise_limit():
     assert disc_sim().problem_kw["newton"].rise_limit == implicit.RISE_LIMIT == 1.0
     mine = disc_sim(newton=NewtonOptions(rise_limit=np.inf)).problem_kw["newton"]
     assert mine.rise_limit == np.inf
+    dyn = PointNewmark({1: 1.0}, 0.01, "dissipative")  # dynamics: whole steps
+    assert disc_sim(dynamics=dyn).problem_kw.get("newton") is None
     assert NewtonOptions().rise_limit is None  # elsewhere: steps across a change taken whole
