@@ -46,3 +46,13 @@ def test_tractions_against_johnson(mu, tmp_path):
 )
 def test_bad_input_exits_2_naming_the_parameter(args, word, tmp_path, capsys):
     assert_refused(demo, args, word, tmp_path, capsys)
+
+
+def test_a_failed_check_names_its_cause(tmp_path):
+    """At a/h = 10 p is 23 % off Johnson's near the edges (docs/demos/flat_punch.md): exit 0
+    with the warning, which names the cause the documents measured (the edges' resolution)."""
+    out = tmp_path / "coarse"
+    assert demo.main(["--h", "0.1", "--out", str(out)]) == 0
+    warnings = json.load(open(out / "metrics.json"))["solver"]["warnings"]
+    johnson = [w for w in warnings if "differs from Johnson's" in w]
+    assert len(johnson) == 1 and "a/h = 10: the edges need a/h >= 20" in johnson[0], warnings
