@@ -68,8 +68,7 @@ def parse(argv):
 
 
 def tractions(sim):
-    """(x, p_n, p_t) at the contact points of the last step (rank 0, sorted by x): pressure
-    positive, p_t the tangential traction on the half-space along +x."""
+    """(x, p_n, p_t) of the last step's contact points on rank 0 by x (p_n: pressure; p_t: +x)."""
     cs, rows = sim.problem.contact, []
     for g, s in zip(cs.pairs, cs.committed):
         rows.append(np.stack([g.points[:, 0], -s["tau_n"], traction_vectors(g, s)[:, 0]], 1))
@@ -84,8 +83,7 @@ def evaluate(run, tab):
     inside = np.abs(x) < WINDOW * p["a"]
     pj, qj = analytic.flat_punch(x[inside], p["a"], p["P"], p["nu"], adhesive)
     err_p = np.abs(pn[inside] / pj - 1)
-    p0 = p["P"] / (np.pi * p["a"])  # the frictionless pressure at the centre: q's scale
-    err_q = np.abs(pt[inside] - qj) / p0
+    err_q = np.abs(pt[inside] - qj) / (p["P"] / (np.pi * p["a"]))  # q / the centre's p (mu 0)
     run.results.update(force=run.rows[-1]["force"], pressure_rel_error_max=float(err_p.max()),
                        pressure_rel_error_mean=float(err_p.mean()),
                        shear_error_max=float(err_q.max()), points_judged=int(inside.sum()))
@@ -96,8 +94,8 @@ def evaluate(run, tab):
             (f"a/h = {p['a'] / p['h']:.3g}: the edges need a/h >= 20", p["a"] / p["h"] < 19.99),
             (f"nu = {p['nu']:g}: towards 1/2 the Q1 cells lock, a finer h helps", p["nu"] > 0.35),
             ("increments after the first: MLS smooths the edges' stress", p["steps"] > 1),
-            ("P1 multipliers cannot follow the edges", p["enforcement"] == "augmented"),
-        ] if on]  # fmt: skip
+            ("P1 multipliers cannot follow the edges", p["enforcement"] == "augmented")]
+            if on]  # fmt: skip
         warn.append(f"p differs from Johnson's by {err_p.max():.1%} (> {TOLERANCE:.0%}) within "
                     f"|x| < {WINDOW} a" + (f" ({'; '.join(why)})" if why else ""))  # fmt: skip
     if adhesive and err_q.max() > SHEAR_TOLERANCE:
@@ -106,8 +104,7 @@ def evaluate(run, tab):
 
 
 def summary(run):
-    r = run.results
-    kind = "adhesive" if run.params["adhesive"] else f"mu = {run.params['mu']:g}"
+    r, kind = run.results, "adhesive" if run.params["adhesive"] else f"mu = {run.params['mu']:g}"
     return (f"Flat punch ({kind}): F = {r['force']:.6g} N/mm; p within |x| < {WINDOW} a: max error "
             f"{r['pressure_rel_error_max']:.2%}, mean {r['pressure_rel_error_mean']:.2%}; q: "
             f"{r['shear_error_max']:.2%} of P / (pi a)")  # fmt: skip
@@ -137,11 +134,9 @@ def main(argv=None):
         steps.measure()
         tab = tractions(sim)
 
-        # the check (rank 0): the tractions against Johnson's
-        if run.rank0:
+        if run.rank0:  # the check: the tractions against Johnson's
             evaluate(run, tab)
-
-        def files(run, folder):
+        def files(run, folder):  # the result files beside metrics.json
             steps.write(folder)
             write_table(folder / "tractions.csv", TRACTION_COLUMNS,
                         [dict(zip(TRACTION_COLUMNS, r)) for r in tab])  # fmt: skip
