@@ -13,6 +13,7 @@ import sys
 
 from dolfinx_forms.app.cli import DemoParser, exit_process
 from dolfinx_forms.app.scene_spec import SpecError
+from dolfinx_forms.common import SolverChoiceError
 from dolfinx_forms.io.folders import OutputFolderError
 
 PROG = "python3 -m dolfinx_forms"
@@ -79,6 +80,8 @@ def main(argv=None):
             return 1
     except (SpecError, OutputFolderError) as e:
         parser.error(str(e))
+    except SolverChoiceError as e:  # found once the problem is built, on every rank alike
+        parser.error(f"solver.linear_solver: {e}")
     if rank0:
         for line in result.failures:
             sys.stderr.write(f"{PROG}: {line}\n")

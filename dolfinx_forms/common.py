@@ -54,6 +54,12 @@ class SpecError(ValueError):
         super().__init__(f"{key}: {message}")
 
 
+class SolverChoiceError(ValueError):
+    """An explicitly chosen linear solver that does not apply to the problem (solvers/linear.py
+    `pick`): a bad input, found once the problem is built and on every rank alike. The demos
+    and the runner exit 2 naming their option."""
+
+
 @contextmanager
 def signals_unwind():
     """Within the block (main thread only), SIGINT raises KeyboardInterrupt and SIGTERM

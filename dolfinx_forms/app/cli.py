@@ -91,6 +91,8 @@ class DemoParser(argparse.ArgumentParser):
         return a
 
     def _parse(self, args, namespace):
+        from mpi4py import MPI
+
         a = super().parse_args(args, namespace)
         if getattr(self, "_discretization", False):  # add_discretization
             check_discretization(self, a)
@@ -101,6 +103,11 @@ class DemoParser(argparse.ArgumentParser):
                 self.error(
                     "--petsc: the condensed linear solver takes no PETSc options (it factorises "
                     "the bulk with MUMPS itself); give --linear-solver factorised or iterative"
+                )
+            if solver == "condensed" and MPI.COMM_WORLD.size > 1:
+                self.error(
+                    "--linear-solver: 'condensed' runs on one process (MUMPS Schur complements "
+                    "are serial); give auto, factorised or iterative"
                 )
             base = ITERATIVE_DEFAULTS if solver == "iterative" else None
             opts = petsc_options(self, getattr(a, self._petsc_dest), base)

@@ -26,6 +26,7 @@ import sys
 from pathlib import Path
 
 from dolfinx_forms.app.checks import console_warnings
+from dolfinx_forms.common import SolverChoiceError
 from dolfinx_forms.io.results import PhaseTimer, new_metrics
 from dolfinx_forms.solvers.newton import ContactSolverError
 
@@ -103,6 +104,12 @@ class Run:
             sys.stderr.write(f"{self.prog}: rank {self.comm.rank} exited ({error.code})\n")
             sys.stderr.flush()
             self.comm.Abort(error.code if isinstance(error.code, int) else 1)
+        if kind is not None and issubclass(kind, SolverChoiceError) and not self.reraise:
+            # a bad --linear-solver found once the problem is built: every rank raises it
+            if self.rank0:
+                sys.stderr.write(f"{self.prog}: error: --linear-solver: {error}\n")
+            self.status = 2
+            return True
         if kind is not None and issubclass(kind, ContactSolverError):
             if self.comm.size > 1:
                 # one rank may fail alone (a step's geometry on its part): the others would

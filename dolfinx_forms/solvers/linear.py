@@ -39,6 +39,7 @@ from petsc4py import PETSc
 from scipy.linalg import lapack
 
 from dolfinx_forms import _cpp, defaults
+from dolfinx_forms.common import SolverChoiceError
 
 DEFAULT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
 # MUMPS's fill-reducing ordering (ICNTL(7)) for a sparsity that serves one load step
@@ -632,7 +633,9 @@ def pick(problem, kind="auto", petsc_options=None):
     if why is None:
         return "condensed", dofs
     if kind == "condensed":
-        raise ValueError(f"linear_solver: 'condensed' does not apply here: {why}")
+        raise SolverChoiceError(
+            f"'condensed' does not apply here: {why}; give auto, factorised or iterative"
+        )
     return "factorised", None
 
 
@@ -650,7 +653,7 @@ def _not_condensed(problem, kind, petsc_options):
     dofs = contact_dofs(problem) if why is None else None
     m, n = (0, problem.num_dofs) if dofs is None else (len(dofs), problem.num_dofs)
     if why is None and not 0 < m <= min(MAX_CONDENSED, n // 4):
-        why = f"{m} contact dofs of {n}"
+        why = f"{m} contact dofs of {n} (it takes 0 < m <= min({MAX_CONDENSED}, n / 4))"
     costly = float(m) ** 3 > defaults.TUNING.condensed_cost * float(n) ** 1.5
     if why is None and kind == "auto" and costly:
         why = f"{m} contact dofs of {n}: a dense update would cost more than a factorisation"

@@ -136,6 +136,21 @@ def test_bad_argument_exit_2_on_every_rank(tmp_path):
     assert sorted(p.name for p in foreign.iterdir()) == ["keep.txt"]
 
 
+def test_the_condensed_solver_on_two_ranks_is_refused_on_every_rank(tmp_path):
+    """MUMPS Schur complements are serial: the demos refuse --linear-solver condensed while
+    parsing, the runner once the problem is built (every rank alike); exit 2, nothing written."""
+    out = tmp_path / "never"
+    demo = [str(ROOT / "demos" / "hertz.py"), "--linear-solver", "condensed", "--out", str(out)]
+    scene = ["-m", "dolfinx_forms", "run", str(ROOT / "demos" / "scenes" / "hertz.toml")]
+    scene += ["--out", str(out), "--set", 'solver.linear_solver="condensed"']
+    for args, name in ((demo, "--linear-solver"), (scene, "solver.linear_solver")):
+        r, wall = mpirun(args, timeout=120, cwd=tmp_path)
+        assert r.returncode == 2, r.stderr[-2000:]
+        lines = [ln for ln in r.stderr.splitlines() if ": error: " in ln]
+        assert len(lines) == 2 and all(f"{name}: 'condensed'" in ln for ln in lines), r.stderr
+        assert "Traceback" not in r.stderr and list(tmp_path.iterdir()) == []
+
+
 def test_ranks_that_read_different_descriptions_stop(tmp_path):
     """The same command line, but each rank's folder holds another scene.toml (MPMD launch with
     one working folder per rank): every rank refuses (exit 2) within seconds, nothing written."""

@@ -68,3 +68,17 @@ def test_augmented_lagrangian_neo_hookean_to_40_percent(tmp_path):
 )
 def test_bad_input_exits_2_naming_the_parameter(args, word, tmp_path, capsys):
     assert_refused(demo, args, word, tmp_path, capsys)
+
+
+def test_a_linear_solver_that_does_not_apply_exits_2(tmp_path, capsys):
+    """--linear-solver condensed on a nonlinear bulk, found once the first step's problem is
+    built: one line naming the option and why, exit 2, no result folder (was a traceback)."""
+    out = tmp_path / "x"
+    args = ["--linear-solver", "condensed", "--h", "0.1", "--steps", "10", "--out", str(out)]
+    assert demo.main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].endswith(
+        ": error: --linear-solver: 'condensed' does not apply here: the bulk is nonlinear (its "
+        "tangent changes every iteration); give auto, factorised or iterative"
+    )  # the program's name first (sys.argv[0]: pytest's in-process)
+    assert not out.exists()
