@@ -37,6 +37,7 @@ laws): F and the law's history at the points, an updated-Lagrangian step on Omeg
 
 from __future__ import annotations
 
+import gc
 import time
 from contextlib import nullcontext
 from dataclasses import dataclass, replace
@@ -324,6 +325,13 @@ class ImplicitMPM:
         for p in [kept[0], *self._made[:-1]]:  # petsc4py frees no PETSc object by itself
             if p is not None and p is not self.problem:
                 p.destroy()
+        kept = p = snap = None
+        self._made = []
+        # a step's problem, scene and mesh hold reference cycles (problem <-> its solver, pairs
+        # <-> bodies): collected now, their memory is free before the next step allocates its
+        # own, which would otherwise come from fresh pages (100 grains x 30 steps: peak memory
+        # 1289 -> 724-754 MB; a collection takes ~25 ms there)
+        gc.collect()
         record = records_[-1]
         for k in _SUMMED:
             record[k] = type(record[k])(sum(r[k] for r in records_))

@@ -1,6 +1,9 @@
 """The implicit MPM step loop (dolfinx_forms.mpm.implicit): rigid motion, a block between rigid
 platens, the Brazilian disc on a coarse grid, and rejected steps."""
 
+import gc
+import weakref
+
 import numpy as np
 import pytest
 from mpi4py import MPI
@@ -245,6 +248,23 @@ def test_each_step_frees_the_problem_it_replaces(monkeypatch):
     assert len(destroyed) == sim.max_splits + 1
     assert all(p is not cur and p.K is None for p in destroyed)
     assert sim.problem is cur and cur.K.handle != 0 and cur.J.handle != 0
+
+
+def test_a_step_collects_the_problem_it_replaces():
+    """A step's problem holds reference cycles (with its solver, pairs, scene): the step that
+    replaces it collects them, so their memory is free before the next step allocates, not
+    whenever Python's collector next runs (100 grains: peak memory 1.10 -> 0.66 GB)."""
+    sim = disc_sim(steps=3)
+    sim.step()
+    old = weakref.ref(sim.problem)
+    enabled = gc.isenabled()
+    gc.disable()  # only the step's own collection
+    try:
+        sim.step()
+        assert old() is None
+    finally:
+        if enabled:
+            gc.enable()
 
 
 def test_obstacle_motion_and_pose():
