@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from dolfinx_forms.mesh.scene import Body, check_cells, gmsh_model, scene_from_gmsh, summary
+from dolfinx_forms.solvers.newton import NewtonOptions
 
 
 # the ranks that compute the top and the bottom platen's contact (modulo the ranks)
@@ -95,22 +96,28 @@ REFERENCE_COLUMNS = [
 ]
 
 
+# Newton iterations a reference step may take: with perfect plasticity (J2, H = 0) hundreds of
+# contact points slip on the Coulomb cone, and an increment of any size re-sorts them into
+# stick and slip a few an iteration (the slip front moves about a node an iteration): 21-29
+# iterations from 1e-5 to 1e-3 of a move at step 39 (h = 0.25), where the default 25 failed
+# at every cut-back. With 40 the three levels complete (docs/demos/disc_crush.md)
+REFERENCE_NEWTON_ITERATIONS = 40
+
+
 def crush_reference(
-    comm, R, sizes, law, steps, step_displacement, substeps=None, log=None, **problem_kw
+    comm, R, sizes, law, steps, step_displacement, substeps=1, log=None, **problem_kw
 ):
     """The body-fitted reference of the disc crush at each cell size in `sizes`: the disc of
     `fitted_disc` (quadrilaterals) between the platens of `meshes.mpm.disc_platens`, u_x = 0 on
     x = 0, `law` at finite strain on a mesh that follows the material
     (`fem.updated.UpdatedLagrangian`), one step per platen move. Returns the rows
     (REFERENCE_COLUMNS; force: on the top platen, positive in compression) of every size;
-    substeps: load steps per platen move (`UpdatedLagrangian.step`); None: 8 for a law with
-    history (J2's Newton diverges from a whole move at h = 0.25 and cuts back to eighths), 1
-    otherwise.
+    substeps: load steps per platen move (`UpdatedLagrangian.step`; J2 too converges from a
+    whole move).
     problem_kw: `solvers.options` keywords (an MPM's levelset_update is ignored)."""
     kw = {k: v for k, v in problem_kw.items() if k != "levelset_update"}  # the MPM's own
-    if substeps is None:
-        substeps = 8 if law.history_size else 1
     kw.setdefault("contact_rank", contact_ranks(comm))
+    kw.setdefault("newton", NewtonOptions(max_iterations=REFERENCE_NEWTON_ITERATIONS))
     return [row for h in sizes for row in _crush(comm, R, h, law, steps, step_displacement,
                                                  substeps, log, kw)]  # fmt: skip
 

@@ -56,7 +56,7 @@ from dolfinx_forms.fem.cut import grid_cells, material_window
 from dolfinx_forms.fem.laws import as_law, law_key
 from dolfinx_forms.mpm import evolution, increment, records
 from dolfinx_forms.mpm import finite_strain as fs
-from dolfinx_forms.solvers.newton import ContactSolverError, NewtonOptions
+from dolfinx_forms.solvers.newton import QUASI_STATIC_RISE_LIMIT, ContactSolverError, NewtonOptions
 from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 
@@ -101,12 +101,13 @@ FINITE_STRAIN_REGULARISATION = 0.1
 EXTRAPOLATE_HISTORY = False
 # NewtonOptions.rise_limit on this path's quasi-static steps (unless the user's NewtonOptions set
 # it): a Newton step across a change of the active set that raises the residual above the
-# solve's lowest is halved on a nonlinear bulk. Finite-strain J2 with friction diverged through
-# such steps on its soft plastic zone (disc_crush.py, H = 0 / 1 at step 8-9, the default J2 at
-# step 24); the details at the option. Not in dynamics: the neo-Hookean disc of
-# bouncing_disc.py (h = 0.2, dt = 0.02, eps0 1e-4) then bounced on, its floor force at rest 0.86
-# to 1.18 of its weight (1.00001-1.00003 with whole steps)
-RISE_LIMIT = 1.0
+# solve's lowest is halved on a nonlinear bulk (solvers/newton.py QUASI_STATIC_RISE_LIMIT, the
+# body-fitted updated Lagrangian's too). Finite-strain J2 with friction diverged through such
+# steps on its soft plastic zone (disc_crush.py, H = 0 / 1 at step 8-9, the default J2 at step
+# 24); the details at the option. Not in dynamics: the neo-Hookean disc of bouncing_disc.py
+# (h = 0.2, dt = 0.02, eps0 1e-4) then bounced on, its floor force at rest 0.86 to 1.18 of its
+# weight (1.00001-1.00003 with whole steps)
+RISE_LIMIT = QUASI_STATIC_RISE_LIMIT
 # step-record counters that add up over a step's sub-steps (the rest: the last sub-step's)
 _SUMMED = ("newton_iterations", "cutbacks", "factorisations", "coupling_rebuilds",
            "mls_widened", "mls_F_nearest", "wall_s", "predicted")  # fmt: skip

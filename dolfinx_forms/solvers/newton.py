@@ -20,6 +20,11 @@ class ContactSolverError(RuntimeError):
     """Newton/linear-solver failure, with the load step and iteration where it happened."""
 
 
+# NewtonOptions.rise_limit of the quasi-static finite-strain steps: the material-point path's
+# (mpm/implicit.py RISE_LIMIT) and the body-fitted updated Lagrangian's (fem/updated.py)
+QUASI_STATIC_RISE_LIMIT = 1.0
+
+
 @dataclass
 class NewtonOptions:
     rtol: float = 1e-10  # residual relative to the first residual of the step
@@ -48,7 +53,8 @@ class NewtonOptions:
     # on a nonlinear bulk, a step that changes the active set and raises the residual above
     # rise_limit times the lowest residual of the solve so far is halved like one that keeps it
     # (None: inf, steps across a change taken whole, except on the material-point path's
-    # quasi-static steps, which take mpm.implicit.RISE_LIMIT = 1). Finite-strain J2 with friction
+    # quasi-static steps and the body-fitted updated Lagrangian's (fem/updated.py), which take
+    # mpm.implicit.RISE_LIMIT = 1). Finite-strain J2 with friction
     # (demos/disc_crush.py, the MPM): whole steps across changes of the contact set on a soft
     # plastic zone raised the residual from 35 to 1e7 in 20 iterations (|du| 8 h an iteration;
     # the tangent is the consistent one, to 1e-9 against differences) and failed perfect
@@ -57,9 +63,9 @@ class NewtonOptions:
     # instead of 31 with cut-backs at the first step), the neo-Hookean crush and the J2 block
     # give the same forces (2e-12). A linear bulk keeps whole steps: with penalty contact its
     # problem is piecewise linear and they end the semismooth Newton in a few iterations (Hertz
-    # under force control: 10-16 iterations instead of <= 6 when halved). The body-fitted J2
-    # reference at H = 0 (h = 0.5 and 1, 16 steps) needs whole steps: at 1 it stalls at 1e-5 of a
-    # solve's first residual, where its active set settles through rising steps
+    # under force control: 10-16 iterations instead of <= 6 when halved). The disc crush's
+    # body-fitted J2 reference diverged alike from a whole platen move; with rise_limit = 1 it
+    # takes whole moves at h = 1 / 0.5 / 0.25 with no cut-back (docs/demos/disc_crush.md)
     rise_limit: float | None = None
     # augmented Lagrangian (Uzawa): stop when no multiplier changes by more than al_rtol of
     # the largest traction *and* no gap by more than al_gtol h (the change of a multiplier is

@@ -86,6 +86,23 @@ def test_disc_crush_reference_converges():
     assert np.all(mid / F[0.5] < 0.03)
 
 
+def test_j2_disc_crush_reference_takes_whole_platen_moves():
+    """J2 (yield 20, H = 100) with friction 0.3 at h = 0.5, 3 platen moves of 0.2 (the demo's):
+    each move is one load step, with no cut-back: the steps halve Newton steps that raise
+    the residual across a change of the active set (`NewtonOptions.rise_limit`, as the MPM's).
+    Without, Newton wandered at 56-280 from 4011 and cut the first move back to a quarter.
+    The forces agree with 8 load steps a move to 1e-3 (measured 2e-4: the return mapping's
+    steps)."""
+    law, lines = J2Plasticity(E, NU, 20.0, 100.0), []
+    kw = dict(mu=0.3, eps0=0.2)
+    whole = crush_reference(MPI.COMM_SELF, 10.0, [0.5], law, 3, 0.2, substeps=1,
+                            log=lines.append, **kw)  # fmt: skip
+    assert not [ln for ln in lines if "cutting" in ln], lines
+    eighths = crush_reference(MPI.COMM_SELF, 10.0, [0.5], law, 3, 0.2, substeps=8, **kw)
+    a, b = (np.array([r["force"] for r in rows]) for rows in (whole, eighths))
+    assert np.all(a > 0) and np.allclose(a, b, rtol=1e-3, atol=0)
+
+
 @pytest.mark.mpi
 def test_disc_crush_reference_on_two_ranks_equals_one():
     """J2 with friction, 3 moves at h = 1 and 2.5 (each platen's contact on its own rank,
