@@ -54,7 +54,7 @@ class NewtonOptions:
     # rise_limit times the lowest residual of the solve so far is halved like one that keeps it
     # (None: inf, steps across a change taken whole, except on the material-point path's
     # quasi-static steps and the body-fitted updated Lagrangian's (fem/updated.py), which take
-    # mpm.implicit.RISE_LIMIT = 1). Finite-strain J2 with friction
+    # QUASI_STATIC_RISE_LIMIT = 1). Finite-strain J2 with friction
     # (demos/disc_crush.py, the MPM): whole steps across changes of the contact set on a soft
     # plastic zone raised the residual from 35 to 1e7 in 20 iterations (|du| 8 h an iteration;
     # the tangent is the consistent one, to 1e-9 against differences) and failed perfect
