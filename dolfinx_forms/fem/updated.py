@@ -22,8 +22,6 @@ moves every quadrature point by du, exactly.
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import basix
 import numpy as np
 import ufl
@@ -35,7 +33,7 @@ from dolfinx_forms.fem.history import CELLS
 from dolfinx_forms.fem.laws import as_law, law_key
 from dolfinx_forms.mpm import records
 from dolfinx_forms.mpm.finite_strain import UpdatedLaw
-from dolfinx_forms.solvers.newton import QUASI_STATIC_RISE_LIMIT, NewtonOptions
+from dolfinx_forms.solvers.newton import quasi_static
 from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 
@@ -123,12 +121,7 @@ class UpdatedLagrangian:
         # the same soft plastic zone under a changing contact set. J2's disc crush wandered at
         # 60-280 from 4011 in a whole platen move (h = 0.5) and was given 8 load steps a move;
         # now it takes whole moves with no cut-back (docs/demos/disc_crush.md)
-        newton = problem_kw.get("newton") or NewtonOptions()
-        if newton.rise_limit is None:
-            problem_kw = dict(
-                problem_kw, newton=replace(newton, rise_limit=QUASI_STATIC_RISE_LIMIT)
-            )
-        self.problem_kw = problem_kw
+        self.problem_kw = quasi_static(problem_kw)
         d = self.d = self.mesh.geometry.dim
         cell = self.mesh.ufl_cell()
 

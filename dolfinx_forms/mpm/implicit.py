@@ -40,7 +40,7 @@ from __future__ import annotations
 import gc
 import time
 from contextlib import nullcontext
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import ufl
@@ -56,7 +56,7 @@ from dolfinx_forms.fem.cut import grid_cells, material_window
 from dolfinx_forms.fem.laws import as_law, law_key
 from dolfinx_forms.mpm import evolution, increment, records
 from dolfinx_forms.mpm import finite_strain as fs
-from dolfinx_forms.solvers.newton import QUASI_STATIC_RISE_LIMIT, ContactSolverError, NewtonOptions
+from dolfinx_forms.solvers.newton import QUASI_STATIC_RISE_LIMIT, ContactSolverError, quasi_static
 from dolfinx_forms.solvers.options import options
 from dolfinx_forms.solvers.problem import ContactProblem
 
@@ -98,7 +98,7 @@ FINITE_STRAIN_REGULARISATION = 0.1
 # iterations per step (the augmented J2: 22.2 -> 16.1), the J2 disc crush (disc_crush.py
 # defaults, the MPM): 1319 -> 377 iterations, 37.9 -> 12.3 s, forces the same to 4e-6; the
 # neo-Hookean crush keeps it (289 -> 210 iterations with it)
-EXTRAPOLATE_HISTORY = False
+
 # NewtonOptions.rise_limit on this path's quasi-static steps (unless the user's NewtonOptions set
 # it): a Newton step across a change of the active set that raises the residual above the
 # solve's lowest is halved on a nonlinear bulk (solvers/newton.py QUASI_STATIC_RISE_LIMIT, the
@@ -159,7 +159,7 @@ class ImplicitMPM:
     "advection" (eq 19) or "reference-map" (the points' map, `evolution.py`); extrapolate:
     quasi-static steps start Newton from the last step's increment per unit of step where that
     lowers the first residual (`increment.py`; False: from du = 0; None: unless a body's law
-    carries a history, `EXTRAPOLATE_HISTORY`). Other keywords go to
+    carries a history: the module's comment "a plastic law's steps" says why). Other keywords go to
     `ContactProblem` (mu, eps0, band, newton, petsc_options, ghost_penalty, ...)."""
 
     def __init__(
@@ -226,9 +226,7 @@ class ImplicitMPM:
         # quasi-static: Newton starts from the last step's increment where that lowers the
         # first residual (`increment.py`); the Increment of the last accepted (sub-)step
         if extrapolate is None:
-            extrapolate = EXTRAPOLATE_HISTORY or not any(
-                law.history_size for law in self.laws.values()
-            )
+            extrapolate = not any(law.history_size for law in self.laws.values())
         self.extrapolate = bool(extrapolate)
         self.increment = None
         self.grid_key = (
@@ -245,9 +243,8 @@ class ImplicitMPM:
             problem_kw.setdefault("multiplier_mass", "lumped")
             if self.point_laws:  # a finite-strain body: the stiffer eps_n (see the constant)
                 problem_kw.setdefault("regularisation", FINITE_STRAIN_REGULARISATION)
-        newton = problem_kw.get("newton") or NewtonOptions()
-        if newton.rise_limit is None and dynamics is None:  # quasi-static: see the constant
-            problem_kw["newton"] = replace(newton, rise_limit=RISE_LIMIT)
+        if dynamics is None:  # quasi-static: see RISE_LIMIT
+            problem_kw = quasi_static(problem_kw)
         options(**problem_kw)  # an unknown option fails here, not at the first step
         self.problem_kw = problem_kw
         # the contact band (the largest initial gap Gamma_c covers): the given one or 2 h to

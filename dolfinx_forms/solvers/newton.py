@@ -9,7 +9,7 @@ committed state with the band doubled (`ContactProblem.grow_band`).
 """
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from mpi4py import MPI
@@ -113,6 +113,15 @@ class NewtonOptions:
     # in 20 steps, h = 0.05): 415 -> 133 factorisations, 8.5 -> 5.6 s, forces to 7e-11
     al_frozen: bool = True
     al_frozen_rate: float = 0.25
+
+
+def quasi_static(problem_kw):
+    """problem_kw with its NewtonOptions' rise_limit set to QUASI_STATIC_RISE_LIMIT, unless the
+    caller set one (the option's comment says why)."""
+    newton = problem_kw.get("newton") or NewtonOptions()
+    if newton.rise_limit is not None:
+        return problem_kw
+    return dict(problem_kw, newton=replace(newton, rise_limit=QUASI_STATIC_RISE_LIMIT))
 
 
 @dataclass

@@ -809,7 +809,7 @@ def test_an_mpm_step_factorises_with_the_short_lived_ordering(monkeypatch):
 def test_the_path_chooses_the_newton_start_and_the_rise_limit():
     """ImplicitMPM's defaults where the user leaves them (None): a quasi-static step starts
     from the last increment unless a body's law carries a history (J2: from du = 0, fewer
-    Newton iterations: `implicit.EXTRAPOLATE_HISTORY`), and a quasi-static step's Newton halves a
+    Newton iterations: mpm/implicit.py), and a quasi-static step's Newton halves a
     step that raises the residual across an active-set change (`implicit.RISE_LIMIT`; not in
     dynamics); a user's choice stands."""
     from dolfinx_forms.fem.plasticity import J2Plasticity
