@@ -65,9 +65,10 @@ class BulkForms:
         self.measure = measure
         # one integral per distinct law, over all its bodies (100 grains of one material: one
         # FFCx kernel, not 100)
+        # the forms read each law's parameters as Constants (`Law.on`): compiled once a law type
         groups = {}
         for t, law in self.laws.items():
-            groups.setdefault(law_key(law), (law, []))[1].append(t)
+            groups.setdefault(law_key(law), (law.on(mesh), []))[1].append(t)
         lin = [
             law.residual(u, v, measure(ts, degree=getattr(law, "quadrature_degree", None)))
             for law, ts in groups.values()
@@ -183,5 +184,6 @@ class BulkForms:
         sig = fem.Function(S, name="stress")
         pts = S.element.interpolation_points()
         for tag, law in self.laws.items():
-            sig.interpolate(fem.Expression(law.cauchy(self.u), pts), self.scene.body_cells(tag))
+            expr = fem.Expression(law.on(self.scene.mesh).cauchy(self.u), pts)
+            sig.interpolate(expr, self.scene.body_cells(tag))
         return sig

@@ -76,7 +76,7 @@ class HistoryLaw(Law):
             F, f = self.kinematics(u)
             parts = [F[i, j] for i in range(self.d) for j in range(self.d)]
             if self.history is not None:
-                new = self.law.history_update(F, f, self.history)
+                new = self.law.on(self.mesh).history_update(F, f, self.history)
                 parts += [new[i] for i in range(self.law.history_size)]
             self._update = (u, fem.Expression(ufl.as_vector(parts), self.points))
         imap = self.mesh.topology.index_map(self.mesh.topology.dim)

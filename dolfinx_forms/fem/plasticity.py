@@ -77,6 +77,7 @@ class LogStrainPlasticity(IsotropicLaw):
     finite_strain = True
     history_size = 5
     initial_history = (1.0, 1.0, 0.0, 1.0, 0.0)
+    runtime = IsotropicLaw.runtime + ("K",)
 
     def __init__(self, E, nu):
         super().__init__(E, nu)
@@ -108,6 +109,8 @@ class J2Plasticity(LogStrainPlasticity):
     """Finite-strain J2 plasticity with linear isotropic hardening (module docstring):
     E, nu (the Hencky elastic law), yield_stress sigma_y > 0, hardening H >= 0; alpha the
     equivalent plastic strain."""
+
+    runtime = LogStrainPlasticity.runtime + ("yield_stress", "hardening")
 
     def __init__(self, E, nu, yield_stress, hardening=0.0):
         super().__init__(E, nu)
@@ -157,6 +160,8 @@ class DruckerPrager(LogStrainPlasticity):
     K eta_bar dgamma, alpha += xi dgamma; when that overshoots the axis (sqrt(J2_trial) <
     G dgamma), return to the apex: s = 0, p = p_trial - K dv with dv = (p_trial - (xi / eta)
     (c + H alpha_n)) / (K + H xi^2 / (eta eta_bar)), alpha += (xi / eta_bar) dv."""
+
+    runtime = LogStrainPlasticity.runtime + ("cohesion", "hardening", "eta", "xi", "eta_bar")
 
     def __init__(self, E, nu, cohesion, friction_angle, dilatancy_angle=None, hardening=0.0):
         super().__init__(E, nu)

@@ -241,7 +241,7 @@ class UpdatedLagrangian:
                 parts = [F[i, j] for i in range(d) for j in range(d)]
                 h = self.history[t]
                 if h is not None:
-                    new = law.law.history_update(F, f, h)
+                    new = law.law.on(self.mesh).history_update(F, f, h)
                     parts += [new[i] for i in range(law.law.history_size)]
                 self._commit[key] = (du, fem.Expression(ufl.as_vector(parts), self.qpoints))
             vals = self._commit[key][1].eval(cells).reshape(len(cells), nq, -1)

@@ -89,9 +89,10 @@ class PointLaw:
         self.dofs = T.dofmap.list.array  # cell -> its DG0 block
         f, Fn = as_tensor(self.f, d), as_tensor(self.Fn, d)
         F = f * Fn
-        out = voigt(self.law.kirchhoff(F, f, self.h) / ufl.det(F), d)
+        law = self.law.on(mesh)
+        out = voigt(law.kirchhoff(F, f, self.h) / ufl.det(F), d)
         if k:
-            new = self.law.history_update(F, f, self.h)
+            new = law.history_update(F, f, self.h)
             out += [new[i] for i in range(k)]
         centre = np.full((1, d), 0.5)
         self.expr = fem.Expression(ufl.as_vector(out), centre)

@@ -7,6 +7,7 @@ import pytest
 import ufl
 from dolfinx import fem, mesh as dmesh
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from dolfinx_forms import Box
 from dolfinx_forms.fem.boundary import Dirichlet
@@ -181,3 +182,67 @@ def test_neo_hookean_on_cut_cells_linear_limit_and_quadratic_newton():
     assert tail, rr
     for k in tail:
         assert np.log10(rr[k]) <= 1.6 * np.log10(rr[k - 1]), rr
+
+
+def _residual_and_signature(law, mesh, u, bind):
+    """(the assembled residual of `law` at u, the FFCx signature of its form): the law bound to
+    the mesh (its parameters Constants, `Law.on`) or with its numbers as UFL literals."""
+    import ffcx.naming
+
+    from dolfinx_forms.fem.history import HistoryLaw
+
+    v = ufl.TestFunction(u.function_space)
+    dx = ufl.dx(metadata={"quadrature_degree": 4})
+    w = HistoryLaw(law, mesh) if law.finite_strain and law.history_size else law
+    form = (w.on(mesh) if bind else w).residual(u, v, dx)
+    b = fem.petsc.assemble_vector(fem.form(form))
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    r = b.array.copy()
+    b.destroy()
+    return r, ffcx.naming.compute_signature([form], "")
+
+
+def test_a_shipped_laws_parameters_are_runtime_constants():
+    """`Law.on(mesh)`: the parameters a shipped law's UFL reads become fem.Constants, so the
+    compiled form is the same for every value (one compile per law type: another E, nu or
+    yield stress finds it in FFCx's cache), and the residual equals the one of the law with
+    its numbers as literals (an independent compile) to round-off."""
+
+    from dolfinx_forms.fem.plasticity import DruckerPrager, J2Plasticity
+
+    mesh = dmesh.create_unit_square(MPI.COMM_WORLD, 4, 4, dmesh.CellType.quadrilateral)
+    V = fem.VectorFunctionSpace(mesh, ("Lagrange", 1))
+    u = fem.Function(V)
+    # DOLFINx gives the mesh's coordinate element its variant at the first form compiled on it
+    # (a cold FFCx cache), which changes the signature of every form made after: one first
+    fem.form(ufl.inner(u, u) * ufl.dx)
+    # a deformation that yields J2 and the cone at these parameters: stretch and shear
+    u.interpolate(lambda x: np.stack([0.08 * x[0] + 0.05 * x[1] ** 2, -0.06 * x[1] + 0.02 * x[0]]))
+    ortho = lambda E1: OrthotropicElastic(E1, 400.0, 300.0, 0.25, 0.3, 0.2, 150.0, 30.0)  # noqa
+    pairs = [
+        (LinearElastic(E, NU), LinearElastic(3 * E, 0.2)),
+        (NeoHookean(E, NU), NeoHookean(2 * E, 0.45)),
+        (J2Plasticity(E, NU, 5.0, 10.0), J2Plasticity(2 * E, 0.25, 3.0, 0.0)),
+        (DruckerPrager(E, NU, 1.0, 30.0, 10.0, 5.0), DruckerPrager(E, 0.2, 2.0, 20.0, 15.0)),
+        (ortho(1000.0), ortho(2000.0)),
+    ]
+    for k, (a, b) in enumerate(pairs):
+        ra, sa = _residual_and_signature(a, mesh, u, True)
+        # UFL numbers Constants by creation: 10^k more of them made in between must not change
+        # the signature (separate Constants per parameter did, past a power of ten)
+        junk = [fem.Constant(mesh, 0.0) for _ in range(10**k % 1000 + 7)]
+        rb, sb = _residual_and_signature(b, mesh, u, True)
+        del junk
+        assert sa == sb, type(a).__name__  # one compiled form for both parameter sets
+        for law, r in ((a, ra), (b, rb)):
+            literal, s_lit = _residual_and_signature(law, mesh, u, False)
+            assert s_lit != sa  # the literals' form is another compile
+            scale = np.abs(literal).max()
+            assert scale > 0
+            assert np.abs(r - literal).max() <= 1e-12 * scale, type(law).__name__
+        assert np.abs(ra - rb).max() > 1e-3 * np.abs(ra).max()  # the values reach the kernel
+    # the numbers stay the law's: describe and the law's key read them, not the Constants
+    law = NeoHookean(E, NU)
+    bound = law.on(mesh)
+    assert not isinstance(bound.mu, float) and law.mu == E / (2 * (1 + NU))
+    assert bound.describe() == law.describe()
