@@ -63,6 +63,8 @@ class BulkForms:
             return dx(tuple(int(t) for t in tag)) if np.ndim(tag) else dx(int(tag))
 
         self.measure = measure
+        # a cut scene's measure of several bodies is one integral per part (`cut.CutIntegration`)
+        compile_form = fem.form if integration is None else integration.form
         # one integral per distinct law, over all its bodies (100 grains of one material: one
         # FFCx kernel, not 100)
         # the forms read each law's parameters as Constants (`Law.on`): compiled once a law type
@@ -84,12 +86,17 @@ class BulkForms:
         if rigid_mode_stiffness > 0:
             # alpha E / L^2 int u . v on each body (L: its bbox diagonal): a floor under the
             # rigid modes of bodies held only by contact (a grain before its contacts close),
-            # relative size alpha on the body's elastic stiffness
+            # relative size alpha on the body's elastic stiffness. alpha E / L^2 per cell (DG0):
+            # one integral per law group, as the laws' own
+            c = fem.Function(fem.FunctionSpace(mesh, ("DG", 0)), name="rigid_mode_stiffness")
+            cell_dof = c.function_space.dofmap.list.array
             for tag, law in self.laws.items():
                 body = next(b for b in scene.bodies if b.tag == tag)
                 L2 = float(np.sum(np.ptp(np.asarray(body.bbox, float), axis=0) ** 2))
-                c = rigid_mode_stiffness * law.modulus / L2
-                a_lin.append(c * ufl.inner(du, v) * measure(tag))
+                c.x.array[cell_dof[scene.body_cells(tag)]] = rigid_mode_stiffness * law.modulus / L2
+            c.x.scatter_forward()
+            self._rigid = c
+            a_lin += [c * ufl.inner(du, v) * measure(ts) for _, ts in groups.values()]
         if integration is not None and ghost_penalty > 0:
             pm = fem.Function(fem.FunctionSpace(mesh, ("DG", 0)), name="p_modulus")
             cell_dof = pm.function_space.dofmap.list.array
@@ -98,21 +105,24 @@ class BulkForms:
             pm.x.scatter_forward()
             self._pm = pm
             a_lin.append(integration.ghost_penalty(du, v, ghost_penalty, pm))
-        self.a_lin = fem.form(sum(a_lin[1:], a_lin[0])) if a_lin else None
+        self.a_lin = compile_form(sum(a_lin[1:], a_lin[0])) if a_lin else None
         self.nonlinear = bool(nl)
         if self.nonlinear:
             F_nl = sum(nl[1:], nl[0])
-            self.F_nl = fem.form(F_nl)
-            self.J_nl = fem.form(ufl.derivative(F_nl, u, du))
+            self.F_nl = compile_form(F_nl)
+            self.J_nl = compile_form(ufl.derivative(F_nl, u, du))
             self.b_nl = fem.petsc.create_vector(self.F_nl)
             # explicit zeros on the nonlinear bodies' cells: PETSc drops preallocated entries
             # never set at the first final assembly, and the Jacobian is a copy of K's pattern
             zero = fem.Constant(mesh, 0.0)
-            dxb = ufl.Measure(
-                "dx", domain=mesh, subdomain_data=scene.cell_tags, metadata={"quadrature_degree": 0}
-            )
             tags = tuple(t for t, law in self.laws.items() if not law.linear)
-            self.a_fill = fem.form(zero * ufl.inner(du, v) * dxb(tags))
+            if integration is None:
+                dxb = ufl.Measure("dx", domain=mesh, subdomain_data=scene.cell_tags,
+                                  metadata={"quadrature_degree": 0})  # fmt: skip
+                self.a_fill = fem.form(zero * ufl.inner(du, v) * dxb(tags))
+            else:  # every cell of those bodies, interior and cut
+                dxb = integration.measure(tags, degree=0)
+                self.a_fill = compile_form(zero * ufl.inner(du, v) * dxb)
         # right-hand sides, assembled once: f(lam) = sum scale_k(lam) f_k
         self.rhs = []
         for t in tractions:
@@ -129,7 +139,7 @@ class BulkForms:
                 L = fem.form(ufl.inner(t.traction, v) * ds(tag))
             self.rhs.append((t, L))
         for load in loads:
-            self.rhs.append((load, fem.form(load.form(v, measure))))
+            self.rhs.append((load, compile_form(load.form(v, measure))))
         self.f_vectors = []
         for _, L in self.rhs:
             b = fem.petsc.assemble_vector(L)

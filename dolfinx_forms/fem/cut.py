@@ -11,6 +11,10 @@ interior (0) or cut (1), and the interior facets of cut cells (ghost-penalty fac
   Q1 elasticity on the grid's rectangles (integrand in Q2) with the default degree 4. The
   user's form is compiled by FFCx unchanged; history variables can live at the same points.
   `CutIntegration.measure(tag)` is the measure: `integrand * measure` gives both parts.
+  Several bodies (a law over 100 grains) share one integral per part: its id stands for the
+  group's ids (`ALIAS_BASE`), and `CutIntegration.form` compiles it once and hands the kernel
+  to each id. Per id, FFCx would compile 2 x 100 copies of the kernel (a neo-Hookean grain
+  assembly: ~10 s a form) and UFL would carry 200 integrals through every step's forms.
 * Ghost penalty (Burman 2010) on the faces F of cut cells, Q1: gamma * p_modulus * h_n *
   int_F [grad u . n] . [grad v . n], with h_n the cell width normal to F. It vanishes on linear
   fields (patch test untouched) and bounds the condition number as cut fractions go to zero.
@@ -20,6 +24,8 @@ interior (0) or cut (1), and the interior facets of cut cells (ghost-penalty fac
   `contact/cut_cell.h`): phi (vertex values) first, then the traction; `_check_layout` checks.
 """
 
+import zlib
+
 import basix
 import numpy as np
 import ufl
@@ -27,6 +33,7 @@ from dolfinx import cpp as _dcpp
 from dolfinx import fem, jit
 
 from dolfinx_forms import _cpp
+from dolfinx_forms.fem import jit_memo
 
 LAYOUT = _cpp.cut_layout()
 KERNELS = _cpp.cut_kernels()
@@ -35,6 +42,10 @@ KERNELS = _cpp.cut_kernels()
 INTERIOR, CUT = 0, 1
 GHOST_FACET = GHOST = 1
 CUT_ID = 1000
+# cell-integral ids from here on stand for a group of bodies' ids (`CutIntegration.measure`);
+# forms holding them are compiled by `CutIntegration.form` (elsewhere they would integrate over
+# nothing: `jit_memo` refuses them)
+ALIAS_BASE = jit_memo.ALIAS_BASE
 _TYPES = {
     0: _dcpp.fem.IntegralType.cell,
     1: _dcpp.fem.IntegralType.exterior_facet,
@@ -42,15 +53,18 @@ _TYPES = {
 }
 
 
-def _mixed_form(ufl_form, replace, subdomains):
+def _mixed_form(ufl_form, replace, subdomains, expand=None):
     """Compile `ufl_form` with FFCx and build a dolfinx Form whose integrals `replace`
-    {(type index, id): kernel address} are the C++ kernels instead of FFCx's.
+    {(type index, id): kernel address} are the C++ kernels instead of FFCx's, and whose cell
+    integral of an id in `expand` {id: ids} is the kernel of each of those ids instead.
 
     Returns (form, module): keep the module alive as long as the form."""
     mesh = ufl_form.ufl_domain().ufl_cargo()
-    ufcx_form, module, _ = jit.ffcx_jit(
-        mesh.comm, ufl_form, form_compiler_params={"scalar_type": "double"}
-    )
+    expand = expand or {}
+    with jit_memo.aliases_allowed(bool(expand)):
+        ufcx_form, module, _ = jit.ffcx_jit(
+            mesh.comm, ufl_form, form_compiler_params={"scalar_type": "double"}
+        )
     integrals, perm = {}, False
     for t, itype in _TYPES.items():
         ids = [ufcx_form.integral_ids(t)[k] for k in range(ufcx_form.num_integrals(t))]
@@ -63,7 +77,7 @@ def _mixed_form(ufl_form, replace, subdomains):
             ptr = replace.get((t, i))
             if ptr is None:
                 ptr = int(module.ffi.cast("uintptr_t", integral.tabulate_tensor_float64))
-            kernels.append((i, ptr))
+            kernels += [(j, ptr) for j in (expand.get(i, (i,)) if t == 0 else (i,))]
         integrals[itype] = (kernels, subdomains[t])
     original = ufl_form.coefficients()
     coeffs = [
@@ -233,6 +247,48 @@ class CutIntegration:
         self.kind = kind
         self.num_cut_cells = len(cells)
         self._keep = []
+        self.aliases = {}  # an alias id: the ids of its group (`measure`, `form`)
+
+    def _alias(self, ids):
+        """The integral id of the cells of `ids` (None for none): the id itself, or for several
+        an alias id in [ALIAS_BASE, ALIAS_BASE + 2^24) named by their values (the same group
+        gets the same id at every step of a run and in every run: the compiled form is found
+        again)."""
+        ids = tuple(sorted(int(i) for i in ids))
+        if len(ids) <= 1:
+            return ids[0] if ids else None
+        a = ALIAS_BASE + (zlib.crc32(np.asarray(ids, np.int64).tobytes()) & 0xFFFFFF)
+        while self.aliases.setdefault(a, ids) != ids:  # another group's (a hash collision)
+            a += 1
+        return a
+
+    def form(self, ufl_form):
+        """`fem.form` of a form whose cell integrals may be on groups of bodies (`measure`):
+        each group's kernel compiled once and given every id of the group. A form in which a
+        body's cells are in two of its integrals (two groups, or a group and the body alone)
+        is compiled per id (one kernel per id and integral type)."""
+        cell = [i.subdomain_id() for i in ufl_form.integrals() if i.integral_type() == "cell"]
+        expand = {a: self.aliases[a] for a in set(cell) if a in self.aliases}
+        if not expand:
+            return fem.form(ufl_form)
+        ids = [j for a in set(cell) for j in expand.get(a, (a,))]
+        if len(ids) != len(set(ids)):
+            per_id = [
+                itg.reconstruct(subdomain_id=j)
+                for itg in ufl_form.integrals()
+                for j in (
+                    expand.get(itg.subdomain_id(), (itg.subdomain_id(),))
+                    if itg.integral_type() == "cell"
+                    else (itg.subdomain_id(),)
+                )
+            ]
+            return fem.form(ufl.Form(per_id))
+        (sd,) = ufl_form.subdomain_data().values()
+        types = ("cell", "exterior_facet", "interior_facet")
+        form, module = _mixed_form(ufl_form, {}, {k: sd.get(t) for k, t in enumerate(types)},
+                                   expand)  # fmt: skip
+        self._keep.append(module)
+        return form
 
     def measure(self, tags=None, degree=None):
         """The measure over the material of the bodies `tags` (a tag, a list, or None: all).
@@ -249,9 +305,10 @@ class CutIntegration:
             metadata={"quadrature_degree": self.degree},
         )
         ids = [int(t) for t in bodies]
-        return BodyMeasure(
-            [(dx(tuple(ids)), None), (dxq(tuple(t + CUT_ID for t in ids)), self.factor)]
-        )
+        if not ids:
+            return BodyMeasure([])
+        cut_ids = [t + CUT_ID for t in ids]
+        return BodyMeasure([(dx(self._alias(ids)), None), (dxq(self._alias(cut_ids)), self.factor)])
 
     def ghost_penalty(self, u, v, gamma, p_modulus):
         """gamma p_modulus h_n [grad u . n][grad v . n] on the ghost facets (a UFL form);

@@ -24,11 +24,17 @@ raises an Exception; this module does the same
   STALE_AGE, is released and the module compiled afresh. A live owner's claim is waited for
   as before.
 
+Cell-integral ids from ALIAS_BASE on stand for a group of bodies (`fem.cut.CutIntegration`):
+DOLFINx knows no cell of them, so a form holding them that is compiled other than by
+`CutIntegration.form` (which hands the group's kernel to each body) raises here instead of
+integrating over nothing.
+
 `install()` wraps the process-local compiler under DOLFINx's MPI wrapper, which therefore stays
 collective (rank 0 first, then the others) exactly as before. The application installs it at
 start-up (`app.startup.start`); a script that uses the library alone may call `install()`.
 """
 
+import contextlib
 import functools
 import os
 import socket
@@ -38,6 +44,11 @@ from pathlib import Path
 from dolfinx_forms.common import signals_unwind
 
 _memo = {}
+# cell-integral ids from here on stand for a group of other ids (`fem.cut.CutIntegration.measure`)
+# and mean nothing to DOLFINx: a form with them is compiled only inside `aliases_allowed`
+# (`CutIntegration.form`, which hands the kernel to each id of the group)
+ALIAS_BASE = 1 << 24
+_aliases = [False]
 _claimed = []  # the .c files of the modules this process is compiling (`_claims`)
 # a claim without an owner file (FFCx alone, or an older version of this module) is taken for
 # abandoned once its .c is this old (s): FFCx rewrites the .c with the module's source when it
@@ -83,11 +94,38 @@ def _representatives(form):
     )
 
 
+@contextlib.contextmanager
+def aliases_allowed(allowed=True):
+    """Compiles of forms with alias ids (ALIAS_BASE) allowed within (the caller expands them)."""
+    before, _aliases[0] = _aliases[0], bool(allowed)
+    try:
+        yield
+    finally:
+        _aliases[0] = before
+
+
+def _check_aliases(ufl_object):
+    import ufl
+
+    if _aliases[0] or not isinstance(ufl_object, ufl.Form):
+        return
+    for itg in ufl_object.integrals():
+        i = itg.subdomain_id()
+        if itg.integral_type() == "cell" and isinstance(i, int) and i >= ALIAS_BASE:
+            raise RuntimeError(
+                f"a cell integral on id {i}, which stands for a group of bodies (a cut scene's "
+                "measure of several bodies): compile the form with CutIntegration.form, which "
+                "gives the kernel to each body (fem.form would integrate over no cell)"
+            )
+
+
 def memoised(local_jit):
-    """local_jit (the process-local `ffcx_jit`) with its results kept by FFCx's key."""
+    """local_jit (the process-local `ffcx_jit`) with its results kept by FFCx's key. A form
+    with alias ids compiled outside `aliases_allowed` raises (`_check_aliases`)."""
 
     @functools.wraps(local_jit)
     def jit(ufl_object, form_compiler_params={}, jit_params={}):
+        _check_aliases(ufl_object)
         key = _key(ufl_object, form_compiler_params, jit_params)
         if key is None:
             return _compile(local_jit, ufl_object, form_compiler_params, jit_params)

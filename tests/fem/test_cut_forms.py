@@ -16,6 +16,7 @@ import ufl
 from dolfinx import fem
 from dolfinx import mesh as dmesh
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from dolfinx_forms import _cpp
 from dolfinx_forms.fem.cut import CUT, GHOST, INTERIOR, CutIntegration
@@ -135,9 +136,13 @@ def test_cut_energy_equals_sub_triangle_rule():
         assert energy == pytest.approx(ref, rel=1e-12)
 
 
-def test_measure_over_many_bodies_is_ufls_own_expansion():
-    # BodyMeasure builds one integral per body id in one Form; UFL's `integrand * dx(ids)` sums
-    # a Form per id: the same integrals, so the same FFCx signature (the same compiled form)
+def test_a_measure_over_many_bodies_is_one_kernel_given_to_each_body():
+    # three bodies (the cells tagged 1, 2, 3 in turn): measure([1, 2, 3]) is one integral per
+    # part, on an id that stands for the group; CutIntegration.form compiles its kernel once and
+    # gives it to the three bodies' ids. The same vector as the bodies' measures one by one (a
+    # kernel per id), also when a body is in two integrals of the form (compiled per id then)
+    from dolfinx_forms.fem import jit_memo
+
     scene, phi, _ = _scene(nx=8)
     nc = len(scene.cell_tags.values)
     scene.cell_tags = dmesh.meshtags(
@@ -146,15 +151,31 @@ def test_measure_over_many_bodies_is_ufls_own_expansion():
     cut = CutIntegration(scene, phi=phi)
     V = fem.VectorFunctionSpace(scene.mesh, ("Lagrange", 1))
     u, v = fem.Function(V), ufl.TestFunction(V)
+    u.interpolate(lambda x: np.stack([0.1 * x[0] ** 2, 0.05 * x[0] * x[1]]))
     integrand = ufl.inner(LAW.stress(u), ufl.grad(v))
     form = integrand * cut.measure([1, 2, 3])
-    reference = sum(
-        (integrand if f is None else integrand * f) * dx for dx, f in cut.measure([1, 2, 3]).parts
-    )
-    assert len(form.integrals()) == len(reference.integrals()) == 6
-    assert form.signature() == reference.signature()
-    b = [fem.petsc.assemble_vector(fem.form(f)) for f in (form, reference)]
-    assert np.allclose(b[0].array, b[1].array, rtol=0, atol=1e-14 * np.abs(b[1].array).max())
+    assert len(form.integrals()) == 2
+    assert min(i.subdomain_id() for i in form.integrals()) >= jit_memo.ALIAS_BASE
+    per_body = sum(integrand * cut.measure(t) for t in (1, 2, 3))
+    assert len(per_body.integrals()) == 6
+
+    def vector(f):
+        b = fem.petsc.assemble_vector(f)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        return b.array.copy()
+
+    ref = vector(fem.form(per_body))
+    assert np.abs(ref).max() > 0
+    assert np.allclose(vector(cut.form(form)), ref, rtol=0, atol=1e-14 * np.abs(ref).max())
+    # body 2 in the group and on its own: one kernel per id cannot be both, so per id
+    twice = vector(cut.form(form + integrand * cut.measure(2)))
+    ref2 = vector(fem.form(per_body + integrand * cut.measure(2)))
+    assert np.allclose(twice, ref2, rtol=0, atol=1e-14 * np.abs(ref2).max())
+    assert not np.allclose(twice, ref)
+    # fem.form of the group's ids would integrate over no cell: refused under the memo
+    jit_memo.install()
+    with pytest.raises(RuntimeError, match="CutIntegration.form"):
+        fem.form(integrand * cut.measure([1, 2]))
 
 
 def test_body_force_is_the_inside_integral():
