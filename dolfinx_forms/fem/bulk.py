@@ -70,7 +70,10 @@ class BulkForms:
         # the forms read each law's parameters as Constants (`Law.on`): compiled once a law type
         groups = {}
         for t, law in self.laws.items():
-            groups.setdefault(law_key(law), (law.on(mesh), []))[1].append(t)
+            key = law_key(law)
+            if key not in groups:
+                groups[key] = (law.on(mesh), [])
+            groups[key][1].append(t)
         lin = [
             law.residual(u, v, measure(ts, degree=getattr(law, "quadrature_degree", None)))
             for law, ts in groups.values()
