@@ -44,7 +44,7 @@ GHOST_FACET = GHOST = 1
 CUT_ID = 1000
 # cell-integral ids from here on stand for a group of bodies' ids (`CutIntegration.measure`);
 # forms holding them are compiled by `CutIntegration.form` (elsewhere they would integrate over
-# nothing: `jit_memo` refuses them)
+# nothing: `jit_memo`, which a CutIntegration installs, refuses them)
 ALIAS_BASE = jit_memo.ALIAS_BASE
 _TYPES = {
     0: _dcpp.fem.IntegralType.cell,
@@ -211,6 +211,9 @@ class CutIntegration:
     def __init__(self, scene, degree=4, phi=None):
         if scene.cell_type != "quadrilateral":
             raise ValueError("cut integration: quadrilateral cells only")
+        # the memo's check: a form on this scene's alias ids (`measure` of several bodies)
+        # compiled by fem.form, which would integrate over no cell, raises (library use too)
+        jit_memo.install()
         self.scene, self.mesh, self.degree = scene, scene.mesh, int(degree)
         mesh, cut = scene.mesh, scene.cut
         self.phi = (

@@ -172,8 +172,8 @@ def test_a_measure_over_many_bodies_is_one_kernel_given_to_each_body():
     ref2 = vector(fem.form(per_body + integrand * cut.measure(2)))
     assert np.allclose(twice, ref2, rtol=0, atol=1e-14 * np.abs(ref2).max())
     assert not np.allclose(twice, ref)
-    # fem.form of the group's ids would integrate over no cell: refused under the memo
-    jit_memo.install()
+    # fem.form of the group's ids would integrate over no cell: refused (a CutIntegration
+    # installs the memo that checks)
     with pytest.raises(RuntimeError, match="CutIntegration.form"):
         fem.form(integrand * cut.measure([1, 2]))
 
