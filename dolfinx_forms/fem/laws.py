@@ -22,7 +22,7 @@ Run-time parameters: the numbers a shipped law's UFL reads (`Law.runtime`: Lame'
 lambda, a yield stress, ...) enter the forms as a `fem.Constant` of the mesh (`Law.on(mesh)`,
 called where the forms are built), not as literals: the compiled kernels then do not depend on
 their values, and a run at another E, nu or yield stress finds them in FFCx's cache instead of
-compiling (block_compression, neo-Hookean: 5.8 s -> 1.8 s for a first run at a new E, of which
+compiling (block_compression, neo-Hookean: 5.8 s -> 2.0 s for a first run at a new E, of which
 4 s were FFCx and the C compiler). A user's law without `runtime` keeps its numbers as literals
 (one compile per value).
 """
@@ -68,9 +68,8 @@ class Law:
     def on(self, mesh):
         """This law for forms on `mesh`: a shallow copy whose `runtime` attributes are the
         entries of one `fem.Constant` of their values (module docstring), and whose inner `law`
-        (a wrapper's:
-        the MPM's UpdatedLaw, Inertia, ...) is bound too. The copy is for building UFL only;
-        the law itself keeps its numbers (penalty scales, `describe`, `law_key`)."""
+        (a wrapper's: the MPM's UpdatedLaw, Inertia, ...) is bound too. The copy is for building
+        UFL only; the law itself keeps its numbers (penalty scales, `describe`, `law_key`)."""
         inner = getattr(self, "law", None)
         if not self.runtime and not isinstance(inner, Law):
             return self
