@@ -58,11 +58,18 @@ LevelSet::LevelSet(StructuredGrid grid, std::vector<double> values)
   const auto& x = _grid.axis(0);
   const auto& y = _grid.axis(1);
   const std::size_t nx = x.size(), ny = y.size();
+  // the stencils depend on the axis position only: once per axis node, not per grid node
+  // (a pair grid's level sets are made afresh at every step of an assembly)
+  std::vector<std::pair<std::size_t, std::array<double, 3>>> sx(nx), sy(ny);
+  for (std::size_t i = 0; i < nx; ++i)
+    sx[i] = fd_weights(x, i);
+  for (std::size_t j = 0; j < ny; ++j)
+    sy[j] = fd_weights(y, j);
   _deriv.assign(nx * ny, {0, 0, 0});
   for (std::size_t j = 0; j < ny; ++j)
     for (std::size_t i = 0; i < nx; ++i) {
-      auto [ix, wx] = fd_weights(x, i);
-      auto [jy, wy] = fd_weights(y, j);
+      const auto& [ix, wx] = sx[i];
+      const auto& [jy, wy] = sy[j];
       double fx = 0, fy = 0;
       for (int k = 0; k < 3; ++k) {
         fx += wx[k] * _values[_grid.node(ix + k, j)];
@@ -74,7 +81,7 @@ LevelSet::LevelSet(StructuredGrid grid, std::vector<double> values)
   // Cross derivative: x-difference of phi_y
   for (std::size_t j = 0; j < ny; ++j)
     for (std::size_t i = 0; i < nx; ++i) {
-      auto [ix, wx] = fd_weights(x, i);
+      const auto& [ix, wx] = sx[i];
       double fxy = 0;
       for (int k = 0; k < 3; ++k)
         fxy += wx[k] * _deriv[_grid.node(ix + k, j)][1];
