@@ -193,6 +193,27 @@ def point_volume_warnings(record):
     return out
 
 
+# a body whose material points lie deeper than this (in h) inside another body or a rigid
+# obstacle is reported: the contact holds the level sets' contours apart, and a point that far
+# past the other's surface is material its level set no longer bounds. The neo-Hookean block
+# at 40 % (advection, h = 0.05): 0.44 h at its corners; with the reference map 1.2 h at 27 %,
+# one step before the run failed (docs/demos/block_compression.md)
+PENETRATION_DEPTH = 0.5
+
+
+def penetration_warnings(record, h):
+    """The bodies of a step record with a material point deeper than PENETRATION_DEPTH h
+    inside another body or an obstacle (`records.penetrations`; one message per body and
+    other, the same at every step: the first step is kept)."""
+    return [
+        f"{name}: material points more than {PENETRATION_DEPTH:g} h inside {other!r} (the "
+        "contact holds the level sets apart, not the points: its level set no longer bounds "
+        "its material there, e.g. at a corner; refine h)"
+        for name, (depth, other) in record.get("penetration", {}).items()
+        if depth > PENETRATION_DEPTH * h
+    ]
+
+
 class Steps:
     """The step loop of a multi-step demo inside its `demo.Run` block:
 
@@ -243,7 +264,8 @@ class Steps:
         except (ContactSolverError, RuntimeError) as e:  # Newton, or the geometry of a step
             raise ContactSolverError(f"step {k + 1}: {e}") from e
         self.records.append(rec)
-        warnings = [*levelset_warnings(rec), *point_volume_warnings(rec)]
+        warnings = [*levelset_warnings(rec), *point_volume_warnings(rec),
+                    *penetration_warnings(rec, self.sim.h)]  # fmt: skip
         for w in [*contact_warnings(self.sim.problem), *warnings]:
             self.checks.setdefault(w, rec["step"])
         if self._x0 is None:  # positions at seeding: the first step's points before it moved
@@ -279,6 +301,12 @@ class Steps:
             factorisations=[r["factorisations"] for r in self.records],  # per step
             coupling_rebuilds=[r["coupling_rebuilds"] for r in self.records],  # per step
             warnings=[f"step {k}: {w}" for w, k in self.checks.items()],
+            # the deepest material point inside another body or an obstacle over the run, in h
+            # (`records.penetrations`; PENETRATION_DEPTH warns)
+            points_inside_max_h=max(
+                (d / sim.h for r in self.records for d, _ in r["penetration"].values()),
+                default=0.0,
+            ),
         )
 
     def write(self, folder):

@@ -489,6 +489,8 @@ class ImplicitMPM:
             evo = evolution.evolve(self, problem, scene)
         for ob in self.obstacles:
             ob.advance(fraction)
+        with self.phase("points"):
+            record["penetration"] = records.penetrations(self)
         if self.dynamics is not None:
             self.dynamics.time += self.dynamics.dt
             record["time"] = self.dynamics.time

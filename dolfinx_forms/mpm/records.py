@@ -145,3 +145,46 @@ def obstacle_forces(problem, obstacles):
             fx=float(F[0]), fy=float(F[1]), moment=problem.comm.allreduce(M, op=MPI.SUM)
         )
     return out
+
+
+def penetrations(sim):
+    """The deepest material point of each body inside another body or inside a rigid obstacle
+    it meets: {body name: (depth, the other's name)}, depth = -phi_other at the point (> 0:
+    inside; bodies with no point inside are left out). The contact acts on the level sets'
+    contours, not on the points: a point past the other's surface is material the level set no
+    longer bounds (a corner rounded by the grid, a drifted level set). Candidates only: the
+    points inside the other's box (an obstacle's current box, a body's material box from
+    `body_boxes`) of the broad phase's pairs; the points are on every rank, so is this."""
+    out = {}
+    # per body its points' coordinates as contiguous columns and their box: a box test of
+    # 6k points costs ~10 us so, ~60 us as an (n, 2) mask (100 grains: ~900 tests a step)
+    cols = {b.tag: (np.ascontiguousarray(sim.points[b.tag].x[:, :2].T)) for b in sim.bodies}
+    spans = {t: (c.min(axis=1), c.max(axis=1)) for t, c in cols.items() if c.shape[1]}
+
+    def test(body, box, phi, other):
+        if body.tag not in spans:
+            return
+        lo, hi = spans[body.tag]
+        if np.any(lo > box[1]) or np.any(hi < box[0]):
+            return
+        (x, y), (x0, y0), (x1, y1) = cols[body.tag], box[0], box[1]
+        at = np.flatnonzero((x >= x0) & (x <= x1) & (y >= y0) & (y <= y1))
+        if len(at):
+            depth = -float(np.min(phi(np.ascontiguousarray(np.stack([x[at], y[at]], 1)))))
+            if depth > out.get(body.name, (0.0, None))[0]:
+                out[body.name] = (depth, other)
+
+    for ob in sim.obstacles:
+        box = ob.current_bbox
+        for b in sim.bodies:
+            if ob.bodies is None or b.tag in np.atleast_1d(ob.bodies):
+                test(b, box, ob.values, ob.name)
+    pairs = sim.candidate_pairs()
+    boxes = sim.body_boxes() if pairs else None
+    for i, j in pairs:
+        for a, c in ((i, j), (j, i)):
+            # the other's material box lies inside its level set's window (its grid)
+            phi = sim.levelsets[sim.bodies[c].tag]
+            test(sim.bodies[a], boxes[c], lambda x: np.asarray(phi.evaluate(x)[0]),
+                 sim.bodies[c].name)  # fmt: skip
+    return out

@@ -122,3 +122,43 @@ def test_a_grid_levelset_shape_is_mapped_too():
     band = np.abs(exact) < 2 * H
     assert np.abs(phi[band] - exact[band]).max() < 1e-4
     assert np.all(phi[exact > 0.4] > 0)
+
+
+def test_material_points_inside_an_obstacle_or_another_body_are_reported():
+    """records.penetrations: the deepest point of each body inside a rigid obstacle it meets
+    or inside another body's level set (the broad phase's pairs), to round-off of the exact
+    signed distances; mpm_run.penetration_warnings names the bodies deeper than 0.5 h, with
+    the same text at every step."""
+    from types import SimpleNamespace
+
+    from dolfinx_forms.app.mpm_run import penetration_warnings
+    from dolfinx_forms.geometry.obstacles import RigidObstacle
+    from dolfinx_forms.mesh.cut_scene import half_plane
+    from dolfinx_forms.mpm import records
+
+    a, b = disc_points(), disc_points()  # unit discs centred at (0, 0) and (1.9, 0)
+    b.x = b.x + [1.9, 0.0]
+    wall = RigidObstacle("wall", half_plane((0.0, 0.85), (0.0, -1.0), 100.0),
+                         bbox=[[-5.0, 0.85], [5.0, 3.0]], center=(0.0, 0.85), bodies=[1])  # a only
+    bodies = [SimpleNamespace(name="a", tag=1), SimpleNamespace(name="b", tag=2)]
+    grids = [grid_around((0.0, 0.0)), grid_around((1.9, 0.0))]
+    levelsets = {t: _cpp.LevelSet(g, np.asarray(df.Circle(c, R)(g.nodes())))
+                 for t, g, c in zip((1, 2), grids, ((0.0, 0.0), (1.9, 0.0)))}  # fmt: skip
+    boxes = np.array([[[-1.1, -1.1], [1.1, 1.1]], [[0.8, -1.1], [3.0, 1.1]]])
+    sim = SimpleNamespace(
+        bodies=bodies, obstacles=[wall], points={1: a, 2: b}, levelsets=levelsets,
+        body_boxes=lambda: boxes, candidate_pairs=lambda: [(0, 1)],
+    )  # fmt: skip
+    depth = records.penetrations(sim)
+    # a: its top points up to 1 - 0.85 inside the wall (less their inset from the circle);
+    # b: its leftmost points ~0.1 inside a (the discs overlap by 0.1), a's into b alike
+    top = a.x[:, 1].max() - 0.85
+    assert depth["a"] == (pytest.approx(top, abs=1e-12), "wall")
+    inside_a = R - np.linalg.norm(b.x, axis=1).min()
+    assert depth["b"][1] == "a" and depth["b"][0] == pytest.approx(inside_a, abs=1e-3)
+    assert 0 < inside_a < top
+    warnings = penetration_warnings({"penetration": depth}, h=0.1)
+    assert len(warnings) == 2 and warnings[0].startswith("a: ") and "'wall'" in warnings[0]
+    assert penetration_warnings({"penetration": depth}, h=0.2) == warnings[:1]
+    wall.offset = np.array([0.0, 1.0])  # the wall moved up past the disc: only b is left
+    assert records.penetrations(sim)["a"] == (pytest.approx(inside_a, abs=1e-3), "b")
