@@ -335,6 +335,10 @@ class ImplicitMPM:
             record[k] = type(record[k])(sum(r[k] for r in records_))
         record["residuals"] = [v for r in records_ for v in r["residuals"]]
         record["substeps"] = len(records_)
+        for r in records_[:-1]:  # the deepest point of any sub-step (`records.penetrations`)
+            for name, (depth, other) in r["penetration"].items():
+                if depth > record["penetration"].get(name, (0.0, None))[0]:
+                    record["penetration"][name] = (depth, other)
         self.step_count += 1
         record["step"] = self.step_count
         return record

@@ -156,8 +156,8 @@ def penetrations(sim):
     points inside the other's box (an obstacle's current box, a body's material box from
     `body_boxes`) of the broad phase's pairs; the points are on every rank, so is this."""
     out = {}
-    # per body its points' coordinates as contiguous columns and their box: a box test of
-    # 6k points costs ~10 us so, ~60 us as an (n, 2) mask (100 grains: ~900 tests a step)
+    # per body its points' coordinates as contiguous columns and their extent, tested first:
+    # 100 grains make ~900 box tests a step, 60-100 ms as (n, 2) masks, ~25 ms so
     cols = {b.tag: (np.ascontiguousarray(sim.points[b.tag].x[:, :2].T)) for b in sim.bodies}
     spans = {t: (c.min(axis=1), c.max(axis=1)) for t, c in cols.items() if c.shape[1]}
 
