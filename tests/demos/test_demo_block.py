@@ -28,6 +28,11 @@ def test_coarse_run_against_the_homogeneous_solution(law, tmp_path):
     assert r["force_rel_error_max"] < 0.02 and r["width_rel_error_max"] < 0.02
     assert r["area_vs_points_rel_max"] < 0.01 and r["mass_rel_change"] == 0
     assert not [w for w in m["solver"]["warnings"] if "homogeneous" in w]
+    # the corner points pass the rounded contour into the platens (records.penetrations):
+    # the deepest over the run and its warning (above 0.5 h) agree
+    deep = m["solver"]["points_inside_max_h"]
+    assert 0 < deep < 2
+    assert any("material points more than" in w for w in m["solver"]["warnings"]) == (deep > 0.5)
     for k in ("mls", "points", "solve", "assembly"):
         assert m["timing_s"][k] > 0
     for f in ("force.png", "F_yy.png", "bodies.csv", "contacts.csv"):
