@@ -736,14 +736,15 @@ class ImplicitMPM:
         ranks = {k: int(r) for k, r in zip(keys, owners)}
         return ranks, {"boxes": boxes, "owners": owners}
 
-    def candidate_pairs(self):
+    def candidate_pairs(self, boxes=None):
         """Body pairs whose boxes, inflated by the contact band (and the level-set grid of the
         pair search), overlap: the broad phase (`_cpp.candidate_pairs`, sort and sweep), so the
-        narrow phase (Gamma_c, eqs 21-24) runs on touching pairs only."""
+        narrow phase (Gamma_c, eqs 21-24) runs on touching pairs only. boxes: `body_boxes()`,
+        if the caller has them."""
         if len(self.bodies) < 2:
             return []
-        band = self.band
-        pairs = _cpp.candidate_pairs(self.body_boxes().reshape(len(self.bodies), 4), 0.5 * band)
+        boxes = self.body_boxes() if boxes is None else boxes
+        pairs = _cpp.candidate_pairs(boxes.reshape(len(self.bodies), 4), 0.5 * self.band)
         return [tuple(int(v) for v in p) for p in np.asarray(pairs).reshape(-1, 2)]
 
     def _quadrature_function(self, scene, dim, name):

@@ -179,8 +179,8 @@ def penetrations(sim):
         for b in sim.bodies:
             if ob.bodies is None or b.tag in np.atleast_1d(ob.bodies):
                 test(b, box, ob.values, ob.name)
-    pairs = sim.candidate_pairs()
-    boxes = sim.body_boxes() if pairs else None
+    boxes = sim.body_boxes() if len(sim.bodies) > 1 else None
+    pairs = sim.candidate_pairs(boxes) if boxes is not None else []
     for i, j in pairs:
         for a, c in ((i, j), (j, i)):
             # the other's material box lies inside its level set's window (its grid)

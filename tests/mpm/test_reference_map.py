@@ -147,7 +147,7 @@ def test_material_points_inside_an_obstacle_or_another_body_are_reported():
     boxes = np.array([[[-1.1, -1.1], [1.1, 1.1]], [[0.8, -1.1], [3.0, 1.1]]])
     sim = SimpleNamespace(
         bodies=bodies, obstacles=[wall], points={1: a, 2: b}, levelsets=levelsets,
-        body_boxes=lambda: boxes, candidate_pairs=lambda: [(0, 1)],
+        body_boxes=lambda: boxes, candidate_pairs=lambda boxes=None: [(0, 1)],
     )  # fmt: skip
     depth = records.penetrations(sim)
     # a: its top points up to 1 - 0.85 inside the wall (less their inset from the circle);
