@@ -141,7 +141,10 @@ void bind_geometry(py::module_& m) {
             const auto pts = input<double>(Arg{"LevelSet.evaluate", "points"}, points, {any, 2});
             const auto x = flat(pts);
             std::vector<double> v(x.size() / 2), g(x.size());
-            l.evaluate(x, v, g);
+            {
+              py::gil_scoped_release release; // pure C++: the pair geometries run in threads
+              l.evaluate(x, v, g);
+            }
             const auto n = py::ssize_t(v.size());
             return py::make_tuple(to_numpy(std::move(v), {n}), to_numpy(std::move(g), {n, 2}));
           },
@@ -204,7 +207,7 @@ void bind_geometry(py::module_& m) {
           py::arg("shape"));
 
   m.def("levelset_from_shape", &levelset_from_shape, py::arg("grid"), py::arg("shape"),
-        "Sample an analytic shape at the grid nodes");
+        py::call_guard<py::gil_scoped_release>(), "Sample an analytic shape at the grid nodes");
   m.def(
       "levelset_from_polyline",
       [](const StructuredGrid& g, const py::object& v, int band) {
@@ -214,6 +217,7 @@ void bind_geometry(py::module_& m) {
       py::arg("grid"), py::arg("vertices"), py::arg("band") = 3,
       "Signed distance to a closed polyline: exact in a band, fast sweeping beyond");
   m.def("reinitialize", &reinitialize, py::arg("phi"), py::arg("max_sweeps") = 8,
+        py::call_guard<py::gil_scoped_release>(),
         "Signed distance with the same zero contour (projection near it, fast sweeping beyond)");
 
   py::enum_<ProjectionStatus>(m, "ProjectionStatus")
@@ -226,8 +230,12 @@ void bind_geometry(py::module_& m) {
       [](const LevelSet& phi, const py::object& points, double rtol, int max_iterations,
          double grad_tol) {
         const auto pts = input<double>(Arg{"closest_point_projection", "points"}, points, {any, 2});
-        ProjectionResult r = closest_point_projection(
-            phi, flat(pts), ProjectionOptions{rtol, max_iterations, grad_tol});
+        ProjectionResult r;
+        {
+          py::gil_scoped_release release;
+          r = closest_point_projection(phi, flat(pts),
+                                       ProjectionOptions{rtol, max_iterations, grad_tol});
+        }
         return projection_dict(std::move(r));
       },
       py::arg("phi"), py::arg("points"), py::arg("rtol") = 1e-10, py::arg("max_iterations") = 50,
@@ -239,8 +247,12 @@ void bind_geometry(py::module_& m) {
       [](const Shape& shape, const py::object& points, double length_scale, double rtol,
          int max_iterations, double grad_tol) {
         const auto pts = input<double>(Arg{"closest_point_projection", "points"}, points, {any, 2});
-        ProjectionResult r = closest_point_projection(
-            shape, flat(pts), length_scale, ProjectionOptions{rtol, max_iterations, grad_tol});
+        ProjectionResult r;
+        {
+          py::gil_scoped_release release;
+          r = closest_point_projection(shape, flat(pts), length_scale,
+                                       ProjectionOptions{rtol, max_iterations, grad_tol});
+        }
         return projection_dict(std::move(r));
       },
       py::arg("shape"), py::arg("points"), py::arg("length_scale"), py::arg("rtol") = 1e-10,
@@ -265,7 +277,11 @@ void bind_geometry(py::module_& m) {
   m.def(
       "contact_surface",
       [](const LevelSet& a, const LevelSet& b, double eps, int num_gauss) {
-        ContactSurface s = contact_surface(a, b, eps, num_gauss);
+        ContactSurface s;
+        {
+          py::gil_scoped_release release;
+          s = contact_surface(a, b, eps, num_gauss);
+        }
         return surface_dict(std::move(s));
       },
       py::arg("phi_i"), py::arg("phi_j"), py::arg("eps"), py::arg("num_gauss") = 2,

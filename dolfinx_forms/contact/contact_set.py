@@ -56,14 +56,19 @@ rows are frozen (`freeze_rows`). Hertz a/20, loads 350-520: p(x) 0.78-1.09 % bod
 Its multipliers are left unclipped too.
 """
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 
 from dolfinx_forms import _cpp
+from dolfinx_forms.common import worker_threads
 from dolfinx_forms.contact.multipliers import Multipliers
 from dolfinx_forms.contact.resultants import traction_resultant
 from dolfinx_forms.geometry.pairs import pair_geometry
 
 STATE_NAMES = {0: "open", 1: "stick", 2: "slip"}
+# candidates a thread of `build_pairs` takes at least (fewer: the loop stays serial)
+PAIRS_PER_THREAD = 8
 _NONE = np.zeros(0)
 
 
@@ -381,13 +386,24 @@ def build_pairs(V, scene, band, rank, obstacles, kw, origins=None):
         for i, b in enumerate(scene.bodies)
         if ob.bodies is None or b.tag in np.atleast_1d(ob.bodies)
     ]
-    pairs, index = [], []
-    for c, (pair, ob) in enumerate(candidates):
-        if owner(pair_key(pair, ob)) != me:
-            continue
+    mine = [(c, pair, ob) for c, (pair, ob) in enumerate(candidates)
+            if owner(pair_key(pair, ob)) == me]  # fmt: skip
+
+    def make(item):
+        c, pair, ob = item
         at = {} if not origins or c not in origins else {"lattice_origin": origins[c]}
-        g = pair_geometry(V, scene, pair, band, obstacle=ob, **{**kw, **at})
-        if g is not None:
-            pairs.append(g)
-            index.append(c)
+        return pair_geometry(V, scene, pair, band, obstacle=ob, **{**kw, **at})
+
+    # the pairs are independent and their level-set work (contact_surface, the projections)
+    # runs in C++ without the GIL: a rank's cores share them (`worker_threads`), in candidate
+    # order, so the pairs and any error are the serial loop's
+    threads = min(worker_threads(V.mesh.comm), len(mine) // PAIRS_PER_THREAD)
+    if threads > 1:
+        scene.body_cells(scene.bodies[0].tag)  # the scene's shared tables made once, here
+        with ThreadPoolExecutor(threads) as pool:
+            made = list(pool.map(make, mine))
+    else:
+        made = [make(item) for item in mine]
+    pairs = [g for g in made if g is not None]
+    index = [c for (c, _, _), g in zip(mine, made) if g is not None]
     return pairs, index

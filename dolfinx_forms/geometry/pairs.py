@@ -27,6 +27,7 @@ the reference configuration; Newton only changes u in the gaps (eqs 27-30). For 
 """
 
 import functools
+import threading
 from dataclasses import dataclass
 
 import basix
@@ -607,17 +608,21 @@ class BodyLocator:
         return self.element.tabulate(0, X)[0, :, :, 0]
 
 
+_LOCATORS_LOCK = threading.Lock()
+
+
 def grid_locator(scene, tag, degree=1, owned_only=False):
     """The GridLocator of body `tag` of a cut scene, made once per scene (the pairs of a body
     and the material-point update share it)."""
-    cache = scene.__dict__.setdefault("_grid_locators", {})
     key = (int(tag), int(degree), bool(owned_only))
-    if key not in cache:
-        cache[key] = GridLocator(
-            scene.mesh, scene.cell_tags, tag, scene.cut, degree, owned_only=owned_only,
-            cells=scene.body_cells(tag),
-        )  # fmt: skip
-    return cache[key]
+    with _LOCATORS_LOCK:  # the pairs are made in threads (`contact_set.build_pairs`)
+        cache = scene.__dict__.setdefault("_grid_locators", {})
+        if key not in cache:
+            cache[key] = GridLocator(
+                scene.mesh, scene.cell_tags, tag, scene.cut, degree, owned_only=owned_only,
+                cells=scene.body_cells(tag),
+            )  # fmt: skip
+        return cache[key]
 
 
 class GridLocator:

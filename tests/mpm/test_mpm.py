@@ -425,6 +425,52 @@ def test_hexagonal_assembly_of_ellipses_in_rigid_plates():
     )
 
 
+@pytest.mark.parametrize("enforcement", ["penalty", "augmented"])
+def test_pairs_made_in_threads_are_the_serial_ones(monkeypatch, enforcement):
+    """`contact_set.build_pairs` makes the pair geometries of a rank in threads: on the
+    15-grain assembly (every grain pair and plate-grain candidate, a step into the
+    compression) the pairs, their order and every array are the serial loop's, bit for bit,
+    with 1 and with 3 threads and the multiplier nodes of the augmented Lagrangian too."""
+    from dolfinx_forms.contact import contact_set
+    from meshes.assembly import grain_assembly
+
+    grid, bodies, plates, build, box, _ = grain_assembly(COMM, 15, h=0.5, aspect=1.1, overlap=0.01)
+    for name, v in (("plate_left", (0.01, 0)), ("plate_top", (0, -0.01))):
+        plates[name].translation = np.array(v)
+    sim = ImplicitMPM(
+        COMM,
+        grid,
+        [MPMBody(n, t, (100e3, 0.2), s) for n, t, s in bodies],
+        build,
+        obstacles=list(plates.values()),
+        mu=np.tan(np.radians(15)),
+        enforcement=enforcement,
+        **quiet,
+    )
+    sim.step()
+    p = sim.problem
+    monkeypatch.setattr(contact_set, "PAIRS_PER_THREAD", 1)
+
+    def made(threads):
+        monkeypatch.setenv("ILS_THREADS", str(threads))
+        cs = contact_set.ContactSet(p.V, p.scene, band=p.band, **p._rebuild["settings"])
+        return cs.index, cs.pairs
+
+    index, serial = made(1)
+    assert len(serial) >= 30  # grain pairs and plates: enough for every thread
+    keys = ["points", "weights", "normals", "p_i", "p_j", "g_n0", "mult_nodes", "mult_weights"]
+    for threads in (2, 3):
+        index_t, pairs = made(threads)
+        assert index_t == index
+        for a, b in zip(serial, pairs):
+            assert a.pair == b.pair and (a.obstacle is b.obstacle)
+            for key in keys:
+                x, y = getattr(a, key), getattr(b, key)
+                assert (x is None and y is None) or np.array_equal(x, y), key
+    if enforcement == "augmented":
+        assert any(g.mult_nodes is not None for g in serial)
+
+
 def test_mesh_kept_when_active_cells_do_not_change():
     """The block between platens moves by 0.0005 h per step: its active cells and their kinds
     stay, so the second step keeps the first step's DOLFINx mesh; the answer equals that of a
