@@ -124,7 +124,8 @@ LevelSet contact::intermediate_levelset(const LevelSet& phi_i, const LevelSet& p
   return combine(phi_i, phi_j, [](double a, double b) { return 0.5 * (a - b); });
 }
 
-LevelSet contact::closing_levelset(const LevelSet& phi_i, const LevelSet& phi_j, double eps) {
+LevelSet contact::closing_levelset(const LevelSet& phi_i, const LevelSet& phi_j, double eps,
+                                   double cap) {
   if (!(eps > 0) or !std::isfinite(eps))
     throw std::invalid_argument("contact region: eps must be a finite length > 0");
   check_same_grid(phi_i, phi_j, "closing_levelset");
@@ -144,7 +145,7 @@ LevelSet contact::closing_levelset(const LevelSet& phi_i, const LevelSet& phi_j,
     std::fill(v.begin(), v.end(), *hi < 0 ? -diag : diag + eps);
     return LevelSet(phi_i.grid(), std::move(v));
   }
-  LevelSet psi = reinitialize(LevelSet(phi_i.grid(), std::move(v)));
+  LevelSet psi = reinitialize(LevelSet(phi_i.grid(), std::move(v)), 8, cap);
   std::vector<double> w(psi.values().begin(), psi.values().end());
   for (double& x : w)
     x += eps;
@@ -167,7 +168,10 @@ ContactSurface contact::contact_surface(const LevelSet& phi_i, const LevelSet& p
     throw std::invalid_argument("contact_surface: num_gauss must be in 1..5, got " +
                                 std::to_string(num_gauss));
   const LevelSet phi = intermediate_levelset(phi_i, phi_j);
-  const LevelSet psi = closing_levelset(phi_i, phi_j, eps);
+  // psi is read through its Hermite interpolant (node values two cells away) on Gamma_int,
+  // where only its sign matters but near psi = 0, at depth eps inside the dilated union: the
+  // distances swept to eps + 4 cells are the whole sweep's there, and the region the same
+  const LevelSet psi = closing_levelset(phi_i, phi_j, eps, eps + 4.0 * phi_i.grid().max_spacing());
   const StructuredGrid& grid = phi.grid();
   const auto& ax = grid.axis(0);
   const auto& ay = grid.axis(1);

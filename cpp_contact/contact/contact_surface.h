@@ -4,6 +4,7 @@
 #include "levelset.h"
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -25,8 +26,10 @@ LevelSet intermediate_levelset(const LevelSet& phi_i, const LevelSet& phi_j);
 /// `min_levelset` (eq 21).
 ///
 /// psi < 0 on the union of the bodies and on the "liquid bridges" narrower than
-/// about 2 eps between them.
-LevelSet closing_levelset(const LevelSet& phi_i, const LevelSet& phi_j, double eps);
+/// about 2 eps between them. With a finite `cap` the distances are swept to cap only
+/// (`reinitialize`): psi is exact where |psi - eps| < cap and keeps its sign elsewhere.
+LevelSet closing_levelset(const LevelSet& phi_i, const LevelSet& phi_j, double eps,
+                          double cap = std::numeric_limits<double>::infinity());
 
 /// @brief Contact-region indicator (eq 22, extended to overlaps): the one definition of the
 /// contact region Omega_c.

@@ -59,7 +59,7 @@ double band_width(const std::vector<double>& a, std::size_t i, std::size_t band)
 
 //-----------------------------------------------------------------------------
 void contact::fast_sweep(const StructuredGrid& grid, std::span<double> d,
-                         std::span<const std::int8_t> fixed, int max_sweeps) {
+                         std::span<const std::int8_t> fixed, int max_sweeps, double cap) {
   const std::size_t n = grid.num_nodes();
   if (d.size() != n or fixed.size() != n)
     throw std::invalid_argument("fast_sweep: d and fixed must have one entry per node (" +
@@ -76,7 +76,7 @@ void contact::fast_sweep(const StructuredGrid& grid, std::span<double> d,
       d[k] = std::abs(d[k]);
       any_fixed = true;
     } else
-      d[k] = inf;
+      d[k] = cap;
   }
   if (!any_fixed)
     throw std::invalid_argument("fast_sweep: no fixed node to sweep from");
@@ -97,6 +97,10 @@ void contact::fast_sweep(const StructuredGrid& grid, std::span<double> d,
     const double ap = i + 1 < nx ? u[k + 1] : inf, hp = i + 1 < nx ? x[i + 1] - x[i] : inf;
     const double bm = j > 0 ? u[k - nx] : inf, gm = j > 0 ? y[j] - y[j - 1] : inf;
     const double bp = j + 1 < ny ? u[k + nx] : inf, gp = j + 1 < ny ? y[j + 1] - y[j] : inf;
+    // every update exceeds the smallest neighbour: none below u[k], nothing to do (the far
+    // field before the front reaches it, or beyond a cap)
+    if (std::min(std::min(am, ap), std::min(bm, bp)) >= u[k])
+      return false;
     double a[2], hx[2], b[2], hy[2];
     const int na = upwind_pair(am, hm, ap, hp, a, hx);
     const int nb = upwind_pair(bm, gm, bp, gp, b, hy);
@@ -132,7 +136,7 @@ void contact::fast_sweep(const StructuredGrid& grid, std::span<double> d,
   }
 }
 //-----------------------------------------------------------------------------
-LevelSet contact::reinitialize(const LevelSet& phi, int max_sweeps) {
+LevelSet contact::reinitialize(const LevelSet& phi, int max_sweeps, double cap) {
   const StructuredGrid& grid = phi.grid();
   std::span<const double> v = phi.values();
   const std::size_t n = v.size();
@@ -220,7 +224,7 @@ LevelSet contact::reinitialize(const LevelSet& phi, int max_sweeps) {
       fixed[k] = 0; // no usable information: let the sweep fill it
   }
 
-  fast_sweep(grid, d, fixed, max_sweeps);
+  fast_sweep(grid, d, fixed, max_sweeps, cap);
   for (std::size_t k = 0; k < n; ++k)
     d[k] = v[k] < 0 ? -d[k] : (v[k] > 0 ? d[k] : 0.0);
   return LevelSet(grid, std::move(d));

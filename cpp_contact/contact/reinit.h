@@ -3,6 +3,7 @@
 
 #include "levelset.h"
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -18,9 +19,12 @@ namespace contact {
 /// Godunov upwind update valid on graded grids), with the sign of phi kept.
 /// @param[in] phi Level set with at least one sign change
 /// @param[in] max_sweeps Cap on Gauss-Seidel sweep rounds (4 orderings each)
+/// @param[in] cap Largest distance swept to: farther nodes get +-cap (a narrow band; the
+/// values below it are those of the whole sweep)
 /// @return The reinitialised level set on the same grid
 /// @throws std::invalid_argument if phi has no zero contour
-LevelSet reinitialize(const LevelSet& phi, int max_sweeps = 8);
+LevelSet reinitialize(const LevelSet& phi, int max_sweeps = 8,
+                      double cap = std::numeric_limits<double>::infinity());
 
 /// @brief Signed distance to a closed polyline (e.g. a gmsh boundary curve).
 ///
@@ -45,9 +49,10 @@ LevelSet levelset_from_polyline(const StructuredGrid& grid, std::span<const doub
 /// @param[in,out] d Distances (>= 0); values at non-fixed nodes are overwritten
 /// @param[in] fixed Flags of the nodes that keep their value
 /// @param[in] max_sweeps Cap on sweep rounds
+/// @param[in] cap Largest distance swept to: the other nodes start there and keep it
 /// @throws std::invalid_argument for a size mismatch, no fixed node, max_sweeps < 1,
 /// or a non-finite fixed value
 void fast_sweep(const StructuredGrid& grid, std::span<double> d, std::span<const std::int8_t> fixed,
-                int max_sweeps);
+                int max_sweeps, double cap = std::numeric_limits<double>::infinity());
 
 } // namespace contact

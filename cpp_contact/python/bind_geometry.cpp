@@ -217,8 +217,10 @@ void bind_geometry(py::module_& m) {
       py::arg("grid"), py::arg("vertices"), py::arg("band") = 3,
       "Signed distance to a closed polyline: exact in a band, fast sweeping beyond");
   m.def("reinitialize", &reinitialize, py::arg("phi"), py::arg("max_sweeps") = 8,
+        py::arg("cap") = std::numeric_limits<double>::infinity(),
         py::call_guard<py::gil_scoped_release>(),
-        "Signed distance with the same zero contour (projection near it, fast sweeping beyond)");
+        "Signed distance with the same zero contour (projection near it, fast sweeping beyond; "
+        "+-cap beyond cap)");
 
   py::enum_<ProjectionStatus>(m, "ProjectionStatus")
       .value("converged", ProjectionStatus::converged)
@@ -264,7 +266,8 @@ void bind_geometry(py::module_& m) {
   m.def("intermediate_levelset", &intermediate_levelset, py::arg("phi_i"), py::arg("phi_j"),
         "phi_int = (phi_i - phi_j)/2 (eq 23)");
   m.def("closing_levelset", &closing_levelset, py::arg("phi_i"), py::arg("phi_j"), py::arg("eps"),
-        "reinitialize(phi_min - eps) + eps (eq 22)");
+        py::arg("cap") = std::numeric_limits<double>::infinity(),
+        "reinitialize(phi_min - eps, cap=cap) + eps (eq 22)");
   m.def(
       "contact_region",
       [](const LevelSet& a, const LevelSet& b, double eps) {

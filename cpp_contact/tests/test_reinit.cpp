@@ -294,6 +294,35 @@ TEST(Reinit, RectangleWithNonConstantFactor) {
   }
 }
 
+TEST(Reinit, CapKeepsTheBandAndTheSign) {
+  // Two discs' union: below the cap the capped sweep is the whole sweep (a node's distance
+  // depends on nearer nodes only), node for node; beyond it +-cap with phi's sign
+  const StructuredGrid grid = StructuredGrid::uniform({-3, -2}, {3, 2}, {96, 64});
+  const LevelSet phi(grid, sample_on_grid(grid, [](auto p) {
+                       return std::min(std::hypot(p[0] + 1.2, p[1]) - 1.0,
+                                       std::hypot(p[0] - 1.3, p[1] - 0.2) - 1.1);
+                     }));
+  const LevelSet full = reinitialize(phi);
+  const double h = grid.max_spacing();
+  for (double cap : {3 * h, 0.5, 1.0}) {
+    const LevelSet psi = reinitialize(phi, 8, cap);
+    std::size_t inside = 0, beyond = 0;
+    for (std::size_t k = 0; k < grid.num_nodes(); ++k) {
+      const double f = full.values()[k], c = psi.values()[k];
+      EXPECT_EQ(std::signbit(c), std::signbit(phi.values()[k]));
+      if (std::abs(f) < cap) {
+        ASSERT_EQ(c, f) << "node " << k << ", cap " << cap;
+        ++inside;
+      } else {
+        ASSERT_EQ(std::abs(c), cap) << "node " << k << ", cap " << cap;
+        ++beyond;
+      }
+    }
+    EXPECT_GT(inside, 100u);
+    EXPECT_GT(beyond, 100u);
+  }
+}
+
 TEST(Reinit, NoZeroContourThrows) {
   const StructuredGrid grid = square_grid(8);
   const LevelSet pos(grid, std::vector<double>(grid.num_nodes(), 1.0));
