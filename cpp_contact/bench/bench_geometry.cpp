@@ -58,4 +58,20 @@ static void BM_Reinitialize(benchmark::State& state) {
 }
 BENCHMARK(BM_Reinitialize)->Arg(250)->Arg(1000)->Unit(benchmark::kMillisecond);
 
+// The closing level set of two discs (eq 22) swept over the whole grid (cap 0 here) and to
+// eps + 4 cells, as contact_surface asks for it (cap 1)
+static void BM_ClosingLevelset(benchmark::State& state) {
+  const std::size_t n = state.range(0);
+  const LevelSet a = disc(n, {0.3, 0.5}, 0.25), b = disc(n, {0.7, 0.5}, 0.148);
+  const double eps = 0.02, cap = state.range(1) ? eps + 4.0 / double(n) : INFINITY;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(closing_levelset(a, b, eps, cap));
+}
+BENCHMARK(BM_ClosingLevelset)
+    ->Args({250, 0})
+    ->Args({250, 1})
+    ->Args({1000, 0})
+    ->Args({1000, 1})
+    ->Unit(benchmark::kMillisecond);
+
 BENCHMARK_MAIN();
