@@ -387,15 +387,12 @@ def _many_bodies_series(sim, rec, folder, monkeypatch):
     assert np.array_equal(data["phi"], sim.union_fields()[0])
 
 
-def test_hexagonal_assembly_of_ellipses_in_rigid_plates():
+def assembly_sim(d=0.01, **kw):
     """15 elliptic grains (aspect 1.1) on a hexagonal lattice, overlapping, in four rigid plates
-    moved inward, mu = tan 15 deg: two compression steps converge, every grain is in
-    equilibrium (its contact resultant below 1e-8 of the largest contact force) and so is the
-    set of plates."""
+    moved inward by d a step, mu = tan 15 deg; kw: more ImplicitMPM options."""
     from meshes.assembly import grain_assembly
 
-    grid, bodies, plates, build, box, _ = grain_assembly(COMM, 15, h=0.5, aspect=1.1, overlap=0.01)
-    d = 0.01
+    grid, bodies, plates, build, _, _ = grain_assembly(COMM, 15, h=0.5, aspect=1.1, overlap=0.01)
     for name, v in (
         ("plate_left", (d, 0)),
         ("plate_right", (-d, 0)),
@@ -403,16 +400,24 @@ def test_hexagonal_assembly_of_ellipses_in_rigid_plates():
         ("plate_top", (0, -d)),
     ):
         plates[name].translation = np.array(v)
-    sim = ImplicitMPM(
+    return ImplicitMPM(
         COMM,
         grid,
         [MPMBody(n, t, (100e3, 0.2), s) for n, t, s in bodies],
         build,
         obstacles=list(plates.values()),
         mu=np.tan(np.radians(15)),
-        predictor_gap=0.25,
         **quiet,
+        **kw,
     )
+
+
+def test_hexagonal_assembly_of_ellipses_in_rigid_plates():
+    """15 elliptic grains (aspect 1.1) on a hexagonal lattice, overlapping, in four rigid plates
+    moved inward, mu = tan 15 deg: two compression steps converge, every grain is in
+    equilibrium (its contact resultant below 1e-8 of the largest contact force) and so is the
+    set of plates."""
+    sim = assembly_sim(predictor_gap=0.25)
     for _ in range(2):
         rec = sim.step()
     fmax = max(p["normal_force"] for p in rec["pairs"])
@@ -432,21 +437,8 @@ def test_pairs_made_in_threads_are_the_serial_ones(monkeypatch, enforcement):
     compression) the pairs, their order and every array are the serial loop's, bit for bit,
     with 1 and with 3 threads and the multiplier nodes of the augmented Lagrangian too."""
     from dolfinx_forms.contact import contact_set
-    from meshes.assembly import grain_assembly
 
-    grid, bodies, plates, build, box, _ = grain_assembly(COMM, 15, h=0.5, aspect=1.1, overlap=0.01)
-    for name, v in (("plate_left", (0.01, 0)), ("plate_top", (0, -0.01))):
-        plates[name].translation = np.array(v)
-    sim = ImplicitMPM(
-        COMM,
-        grid,
-        [MPMBody(n, t, (100e3, 0.2), s) for n, t, s in bodies],
-        build,
-        obstacles=list(plates.values()),
-        mu=np.tan(np.radians(15)),
-        enforcement=enforcement,
-        **quiet,
-    )
+    sim = assembly_sim(enforcement=enforcement)
     sim.step()
     p = sim.problem
     monkeypatch.setattr(contact_set, "PAIRS_PER_THREAD", 1)
