@@ -39,6 +39,9 @@ from dolfinx_forms.solvers.options import ContactOptions, FemOptions, SolverOpti
 # active points with an initial gap above this fraction of the band reach its edge: the band
 # doubles and the step is done again (`ContactProblem.grow_band`; `checks.pair_warnings`)
 BAND_EDGE = 0.9
+# growths of the contact sparsity by the closing points' reach before a step is accepted;
+# the next one takes every law point of the band (`ContactProblem._grow_coupling`)
+MAX_STEP_GROWTHS = 2
 
 
 class ContactProblem:
@@ -109,6 +112,7 @@ class ContactProblem:
             )
         self.coupling_gap = None if so.coupling_gap is None else float(so.coupling_gap) * h
         self.coupling_rebuilds = 0  # matrices built again for a point outside the sparsity
+        self.step_growths = 0  # of the sparsity since the last accepted step (`_grow_coupling`)
         self.short_lived = bool(so.short_lived)  # `linear.Factorised`'s ordering
         picked = linear.pick(self, so.linear_solver, so.petsc_options)
         self._coupled = picked[0] == "factorised"
@@ -168,15 +172,20 @@ class ContactProblem:
 
     def _coupling_points(self):
         """Per pair, a mask of the law points whose tangent blocks the sparsity holds: those
-        with a gap below the larger of coupling_gap and predictor_gap before the step's
-        deformation (`ContactSet.law_gaps0`) or at the end of the predicted increment
-        (`guess`); None (every law point) without a coupling_gap or where the linear solver is
-        not `Factorised`."""
+        with a gap below coupling_gap before the step's deformation (`ContactSet.law_gaps0`;
+        below predictor_gap on a pair with no closed point) or at the end of the predicted
+        increment (`guess`); None (every law point) without a coupling_gap or where the linear
+        solver is not `Factorised`."""
         if self.coupling_gap is None or not self._coupled:
             return None
-        # the predictor's first tangent holds the touching points too
-        gap = max(self.coupling_gap, self.predictor_gap)
-        coupled = [self.contact.law_gaps0(k) < gap for k in range(len(self.pairs))]
+        gap = self.coupling_gap
+        gaps0 = [self.contact.law_gaps0(k) for k in range(len(self.pairs))]
+        coupled = [g < gap for g in gaps0]
+        if self.predictor_gap > 0:  # a pair that touches, none of it closed: the predictor's
+            # first tangent holds its bodies (a closed pair's touching points need not)
+            coupled = [
+                c | ((g < self.predictor_gap) & ~np.any(g < 0)) for c, g in zip(coupled, gaps0)
+            ]
         if self.guess is not None:  # else the first iteration's tangent grows the sparsity
             with self.phase("contact"):
                 self.guess(self, 1.0)
@@ -194,19 +203,33 @@ class ContactProblem:
         on any rank."""
         if self.coupled is None:
             return None
-        out = [(s["law_coupled"] != 0) & ~c for s, c in zip(self.contact.last, self.coupled)]
+        # closed points only: a touching point's predictor tangent (an open point's) outside
+        # the sparsity is dropped, which leaves the first iterate's residual exact
+        out = [
+            (s["law_coupled"] != 0) & (s["law_state"] > 0) & ~c
+            for s, c in zip(self.contact.last, self.coupled)
+        ]
         return out if self.comm.allreduce(any(o.any() for o in out), op=MPI.LOR) else None
 
     def _grow_coupling(self, outside):
         """The sparsity grown by the points `outside` and by every law point whose current gap
-        is below the largest of theirs (or coupling_gap); matrices and solver built again."""
+        is below the largest of theirs (or coupling_gap); matrices and solver built again.
+        Past MAX_STEP_GROWTHS growths before a step is accepted it takes every law point of
+        the band: Newton's iterates in a failing step (before its cut-back) close points far
+        apart one after the other, and each growth costs an assembly and a symbolic
+        factorisation (30 grains, 10 + 5 steps: 178 growths for 472 Newton iterations)."""
+        self.coupling_rebuilds += 1
+        self.step_growths += 1
+        if self.step_growths > MAX_STEP_GROWTHS:
+            self.coupled = None
+            self._rebuild_linear(renew=True)
+            return
         gaps = [s["law_g_n"] for s in self.contact.last]
         reach = max(
             [self.coupling_gap] + [float(np.max(g[o])) for g, o in zip(gaps, outside) if o.any()]
         )
         reach = self.comm.allreduce(reach, op=MPI.MAX)
         self.coupled = [c | o | (g <= reach) for c, o, g in zip(self.coupled, outside, gaps)]
-        self.coupling_rebuilds += 1
         self._rebuild_linear(renew=True)
 
     def _rebuild_linear(self, renew=False):
@@ -404,6 +427,7 @@ class ContactProblem:
         return self.R.norm()
 
     def commit(self, lam):
+        self.step_growths = 0
         if self.control is not None:
             self.control.commit(lam)
         self.contact.commit()

@@ -430,6 +430,28 @@ def test_hexagonal_assembly_of_ellipses_in_rigid_plates():
     )
 
 
+def test_touching_points_stay_outside_the_sparsity():
+    """The predictor's closed tangent at touching open points (gap below predictor_gap, 0.5 h
+    here) does not enter J's sparsity, which holds the points closer than coupling_gap
+    (`SolverOptions`; J drops the predictor's other blocks): on the 15-grain assembly's first
+    compression step, fewer points coupled than touching, and the forces those of the
+    sparsity of every law point to 1e-9."""
+    recs, sims = {}, {}
+    for gap in (None, 0.01):
+        sims[gap] = sim = assembly_sim(predictor_gap=0.25, coupling_gap=gap)
+        recs[gap] = sim.step()
+    p = sims[0.01].problem
+    coupled = sum(int(c.sum()) for c in p.coupled)
+    touching = sum(int((p.contact.law_gaps0(k) < 0.25).sum()) for k in range(len(p.pairs)))
+    assert 0 < coupled < touching and sims[None].problem.coupled is None
+    full, limited = recs[None], recs[0.01]
+    fmax = max(q["normal_force"] for q in full["pairs"])
+    assert len(limited["pairs"]) == len(full["pairs"])
+    for a, b in zip(full["pairs"], limited["pairs"]):
+        assert abs(a["normal_force"] - b["normal_force"]) <= 1e-9 * fmax
+        assert abs(a["tangential_force"] - b["tangential_force"]) <= 1e-9 * fmax
+
+
 @pytest.mark.parametrize("enforcement", ["penalty", "augmented"])
 def test_pairs_made_in_threads_are_the_serial_ones(monkeypatch, enforcement):
     """`contact_set.build_pairs` makes the pair geometries of a rank in threads: on the

@@ -43,6 +43,26 @@ def test_grown_sparsity_gives_the_full_sparsity_answer(kind):
         p.destroy()
 
 
+def test_growth_past_the_bound_takes_the_whole_band(monkeypatch):
+    """Past MAX_STEP_GROWTHS growths before a step is accepted the sparsity takes every law
+    point of the band (a failing step's iterates would grow it again and again): with the
+    bound at 0 the first growth does, and the answer is still the full sparsity's."""
+    from dolfinx_forms.solvers import problem
+
+    full = run("conforming", None)
+    monkeypatch.setattr(problem, "MAX_STEP_GROWTHS", 0)
+    bounded = run("conforming", 0.0)
+    assert bounded.coupled is None and bounded.coupling_rebuilds >= 1
+    nnz = [p.comm.allreduce(p.J.getInfo()["nz_used"], op=MPI.SUM) for p in (full, bounded)]
+    assert nnz[1] == nnz[0]
+    uf = np.concatenate(full.comm.allgather(full.u.x.array[: full.n_owned]))
+    ub = np.concatenate(bounded.comm.allgather(bounded.u.x.array[: bounded.n_owned]))
+    assert np.abs(ub - uf).max() <= 1e-9 * np.abs(uf).max()
+    assert bounded.reached == pytest.approx(full.reached, rel=1e-9)
+    for p in (full, bounded):
+        p.destroy()
+
+
 def test_coupling_gap_is_checked():
     with pytest.raises(ValueError, match="coupling_gap"):
         run("conforming", -1.0)
