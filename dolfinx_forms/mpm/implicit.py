@@ -25,8 +25,10 @@ rigid level sets (`obstacles.py`). One load step:
 
 Nothing persistent changes before step 4 converges, and `snapshot`/`restore` copy every piece
 of state (points, level sets, obstacle poses, friction record, counters): a rejected step leaves
-the simulation exactly as it was. A quasi-static step that fails is done again in halves,
-each on its own cut cells (`step`, `max_splits`).
+the simulation exactly as it was (`problem` then is the last converged step's, whose
+matrices the step freed before it built its own: `ContactProblem.release_matrices`). A
+quasi-static step that fails is done again in halves, each on its own cut cells (`step`,
+`max_splits`).
 
 Linear laws: small strain per step with the Jaumann update of the points' stress
 (material_points.py). Finite-strain laws (`Law.finite_strain`: NeoHookean, J2Plasticity, user
@@ -394,6 +396,8 @@ class ImplicitMPM:
     def _step(self, fraction=1.0):
         """The solve and update of `fraction` of the step (lam from 0 to fraction)."""
         t0 = time.perf_counter()
+        if self.problem is not None:  # its matrices go before this step makes its own
+            self.problem.release_matrices()
         with self.phase("mesh"):
             pairs = self.candidate_pairs()
             ranks, contact_boxes = self.contact_ranks(pairs)
