@@ -300,18 +300,6 @@ class ContactProblem:
         usable (a later solve factorises again)."""
         self.linear.release()
 
-    def release_matrices(self):
-        """Free the factorisations and the Newton step's matrices and vectors (K, J, R, Ku,
-        f); the solution, the contact state and the scene stay, but the problem assembles and
-        solves no more. A material-point step calls it for the problem it replaces before it
-        builds its own (`ImplicitMPM._step`): kept for a failed step to fall back to, those
-        matrices were held through the new step's factorisations."""
-        if self.K is None:
-            return
-        self.linear.release()
-        linear.destroy(self.K, self.J, self.R, self.Ku, self.f)
-        self.K = self.J = self.R = self.Ku = self.f = None
-
     # ------------------------------------------------------------------ utilities
     @property
     def factorisations(self):
