@@ -89,10 +89,10 @@ class SolverOptions:
     closed points hold the bodies). 0.01 h: 100 grains x 30 steps, 1.06e9 flops a
     factorisation against 1.45e9 at 0.05 h with the predictor's 0.05 h (the MUMPS factor 14 %
     smaller), no growth, the same forces to 5e-13. None: every law point of the band.
-    short_lived: the problem serves
-    one load step (an MPM step on its own mesh), so `Factorised` has MUMPS order by AMD, whose
-    analysis costs less than METIS's extra fill saves over a few Newton iterations
-    (`linear.SHORT_LIVED_ORDERING`; a mat_mumps_icntl_7 among petsc_options wins)."""
+    short_lived: the problem serves one load step (an MPM step on its own mesh), so
+    `Factorised` has MUMPS order by AMD, whose analysis costs less than METIS's extra fill
+    saves over a few Newton iterations (`linear.SHORT_LIVED_ORDERING`; a mat_mumps_icntl_7
+    among petsc_options wins)."""
 
     newton: object = None
     petsc_options: dict | None = None
