@@ -87,8 +87,8 @@ class SolverOptions:
     every law point of the band). The predictor's touching points (predictor_gap) are in it
     on a pair with no closed point; elsewhere their first tangent is dropped (their pair's
     closed points hold the bodies). 0.01 h: 100 grains x 30 steps, 1.06e9 flops a
-    factorisation against 1.45e9 at 0.05 h with the predictor's 0.05 h (the MUMPS factor 14 %
-    smaller), no growth, the same forces to 5e-13. None: every law point of the band.
+    factorisation against 1.45e9 at 0.05 h with the predictor's 0.05 h, no growth, the same
+    forces to 5e-13. None: every law point of the band.
     short_lived: the problem serves one load step (an MPM step on its own mesh), so
     `Factorised` has MUMPS order by AMD, whose analysis costs less than METIS's extra fill
     saves over a few Newton iterations (`linear.SHORT_LIVED_ORDERING`; a mat_mumps_icntl_7
