@@ -324,13 +324,13 @@ class ImplicitMPM:
             # too unless kept: the next step builds both again from the restored state
             self.problem = self.scene = self._key = None
             raise
+        split = len(self._made) > 1
         for p in self._made[:-1]:  # petsc4py frees no PETSc object by itself
             p.destroy()
-        if len(self._made) > 1:  # a split step's sub-problems: collected now (`_drop_previous`)
-            self._made = []
-            gc.collect()
         p = snap = None
         self._made = []
+        if split:  # a split step's sub-problems: collected now (`_drop_previous`)
+            gc.collect()
         record = records_[-1]
         for k in _SUMMED:
             record[k] = type(record[k])(sum(r[k] for r in records_))

@@ -222,14 +222,11 @@ class ContactProblem:
         self.step_growths += 1
         if self.step_growths > MAX_STEP_GROWTHS:
             self.coupled = None
-            self._rebuild_linear(renew=True)
-            return
-        gaps = [s["law_g_n"] for s in self.contact.last]
-        reach = max(
-            [self.coupling_gap] + [float(np.max(g[o])) for g, o in zip(gaps, outside) if o.any()]
-        )
-        reach = self.comm.allreduce(reach, op=MPI.MAX)
-        self.coupled = [c | o | (g <= reach) for c, o, g in zip(self.coupled, outside, gaps)]
+        else:
+            gaps = [s["law_g_n"] for s in self.contact.last]
+            grown = [float(np.max(g[o])) for g, o in zip(gaps, outside) if o.any()]
+            reach = self.comm.allreduce(max([self.coupling_gap] + grown), op=MPI.MAX)
+            self.coupled = [c | o | (g <= reach) for c, o, g in zip(self.coupled, outside, gaps)]
         self._rebuild_linear(renew=True)
 
     def _rebuild_linear(self, renew=False):
