@@ -29,9 +29,12 @@ def _setup_mpi():
     # is read by MPI_Init only and removed after it: an mpirun started from this process must
     # not inherit btl=self. A launched process (mpirun, srun, hydra) keeps the defaults.
     launched = ("OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE", "SLURM_PROCID")
+    alone = "mpi4py.MPI" not in sys.modules and not any(k in os.environ for k in launched)
     singleton = {"OMPI_MCA_pml": "ob1", "OMPI_MCA_btl": "self"}
-    if "mpi4py.MPI" in sys.modules or any(k in os.environ for k in launched + (*singleton,)):
+    if not alone or any(k in os.environ for k in singleton):
         singleton = {}
+    if alone and os.environ.get("OMPI_MCA_ess_singleton_isolated") == "1":
+        singleton.update(isolated_session_dir(os.environ))
     os.environ.update(singleton)
     try:
         from mpi4py import MPI
@@ -43,6 +46,25 @@ def _setup_mpi():
         from dolfinx_forms.app import mpi_errors
 
         mpi_errors.install()
+
+
+def isolated_session_dir(environ) -> dict:
+    """{OMPI_MCA_orte_top_session_dir: a folder of this process's own} for an isolated Open MPI
+    singleton, {} where the user chose one.
+
+    Why: every isolated singleton (no helper daemon: `start`) has the same name, job 1 of job
+    family 0, so all of them share the session folder <tmp>/ompi.<host>.<uid>/jf.0/1, and each
+    removes it at MPI_Finalize when empty. Two runs at once (a parameter sweep, a test that
+    starts a demo) then race: one's MPI_Init fails with "A call to mkdir was unable to create
+    the desired directory ... jf.0/1" and exit 1 (3 of 745 runs of four concurrent Hertz
+    demos). A folder per process, which Open MPI creates and removes itself, has no one to race
+    with; a killed run leaves its empty folders behind, as Open MPI's own do."""
+    if "OMPI_MCA_orte_top_session_dir" in environ:
+        return {}
+    import tempfile
+
+    name = f"ompi.{os.uname().nodename}.{os.getuid()}.singleton.{os.getpid()}"
+    return {"OMPI_MCA_orte_top_session_dir": os.path.join(tempfile.gettempdir(), name)}
 
 
 def _import_ufl_ffcx():

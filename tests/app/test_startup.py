@@ -51,6 +51,32 @@ def test_user_mpi_settings_kept():
     assert r["env"] == {"OMPI_MCA_pml": "ob1", "OMPI_MCA_btl": "self,vader"}
 
 
+SESSION = """
+import json, os
+from dolfinx_forms.app import startup
+startup.start()
+from mpi4py import MPI
+mine = startup.isolated_session_dir({})["OMPI_MCA_orte_top_session_dir"]
+print(json.dumps(dict(top=mine, inside=os.path.isdir(os.path.join(mine, "jf.0", "1", "0")),
+                      env=os.environ.get("OMPI_MCA_orte_top_session_dir"))))
+"""
+
+
+def test_isolated_singletons_have_their_own_session_folder():
+    """Every isolated singleton is job 1 of family 0: a shared session folder made two runs at
+    once race (one's MPI_Init failed to mkdir .../jf.0/1, exit 1). Each process has its own,
+    named by its pid, which Open MPI removes at MPI_Finalize; the setting does not stay in the
+    environment; a user's own choice is kept."""
+    r = _python(SESSION)
+    assert r["inside"] and r["env"] is None
+    assert str(os.getpid()) not in r["top"] and not os.path.exists(r["top"])
+    from dolfinx_forms.app import startup
+
+    assert startup.isolated_session_dir({"OMPI_MCA_orte_top_session_dir": "/x"}) == {}
+    mine = startup.isolated_session_dir({})["OMPI_MCA_orte_top_session_dir"]
+    assert mine.endswith(f".singleton.{os.getpid()}")
+
+
 def test_pkg_resources_still_works_after():
     r = _python(
         "import json, dolfinx_forms.app, pkg_resources\n"
