@@ -7,7 +7,8 @@ imported. The library itself (`import dolfinx_forms`) does none of this.
   glibc's transparent huge pages for large allocations (`huge_pages_restart`);
 * an early plotting worker for a demo (io/plot_worker.py: matplotlib's import overlaps ours);
 * Open MPI singleton settings (no helper daemon, no transport probing: ~0.6 s of a
-  singleton's start), removed from the environment again after MPI_Init;
+  singleton's start; a session folder of its own, `isolated_session_dir`), removed from the
+  environment again after MPI_Init;
 * one OpenBLAS thread per MPI rank under mpirun (the ranks already share the cores);
 * UFL's and FFCx's version look-up without scanning every installed distribution;
 * quiet JIT loggers (app/logs.py) and, under mpirun, an error on one rank ends every rank
