@@ -21,6 +21,35 @@ def program_name() -> str:
     return name if name and name not in ("-c", "-m") else "python3"
 
 
+MPI_ENVIRONMENT_PREFIXES = ("PMIX_", "OMPI_", "ORTE_")  # what Open MPI's MPI_Init sets
+
+
+def drop_mpi_environment() -> list[str]:
+    """Unset the variables MPI_Init put in this process's C environment (PMIX_*, OMPI_*,
+    ORTE_* that os.environ, the environment the process started with plus Python's own
+    changes, does not hold); returns their names.
+
+    Why: Python's subprocess with env=None passes the C environment, and an Open MPI singleton
+    writes its helper daemon's address and its own identity there (PMIX_SERVER_URI*,
+    PMIX_NAMESPACE, PMIX_RANK=0). A child MPI program then takes itself for a launched rank:
+    it joins this process's job as a second rank 0 (pytest's process and every demo it ran
+    shared one namespace). Variables the process started with (under mpirun) are kept."""
+    import ctypes
+
+    try:
+        environ = ctypes.POINTER(ctypes.c_char_p).in_dll(ctypes.CDLL(None), "environ")
+    except (OSError, ValueError, AttributeError):
+        return []
+    names, i = [], 0
+    while environ[i] is not None:
+        names.append(environ[i].split(b"=", 1)[0].decode(errors="replace"))
+        i += 1
+    dropped = [n for n in names if n.startswith(MPI_ENVIRONMENT_PREFIXES) and n not in os.environ]
+    for n in dropped:
+        os.unsetenv(n)
+    return dropped
+
+
 def worker_threads(comm):
     """Threads each rank gives its C++ loops over points (the MLS projection): ILS_THREADS if
     set (>= 1), else this process's cores shared among the ranks (at least 1). Results do not

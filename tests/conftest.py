@@ -22,9 +22,23 @@ def _source_tree():
 
 
 def pytest_configure(config):
+    _drop_mpi_environment()
     root = _source_tree()
     if root is None:
         return
     parts = [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
     if str(root) not in {str(Path(p).resolve()) for p in parts}:
         os.environ["PYTHONPATH"] = os.pathsep.join([str(root), *parts])
+
+
+def _drop_mpi_environment():
+    """MPI initialised now, and what its MPI_Init wrote to the C environment dropped
+    (dolfinx_forms.common.drop_mpi_environment). Outside mpirun this process is an Open MPI
+    singleton with a helper daemon, whose address and rank 0 subprocess would pass to every
+    child started with env=None: each demo joined this process's job as a second rank 0 (and
+    one in several hundred ended with exit 1 and nothing on either stream)."""
+    from mpi4py import MPI  # noqa: F401
+
+    from dolfinx_forms.common import drop_mpi_environment
+
+    drop_mpi_environment()

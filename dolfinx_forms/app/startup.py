@@ -42,6 +42,10 @@ def _setup_mpi():
     finally:
         for k in singleton:
             del os.environ[k]
+    # what MPI_Init wrote to the C environment must not reach the programs this one starts
+    from dolfinx_forms.common import drop_mpi_environment
+
+    drop_mpi_environment()
 
     if MPI.COMM_WORLD.size > 1:
         from dolfinx_forms.app import mpi_errors

@@ -77,6 +77,34 @@ def test_isolated_singletons_have_their_own_session_folder():
     assert mine.endswith(f".singleton.{os.getpid()}")
 
 
+CHILD_MPI_ENV = (
+    "import json, os; print(json.dumps(sorted(k for k in os.environ"
+    " if k.startswith(('PMIX_', 'OMPI_', 'ORTE_')))))"
+)
+
+
+def test_mpi_init_environment_not_passed_to_children():
+    """MPI_Init writes a singleton's daemon address and PMIX_RANK=0 to the C environment, which
+    subprocess passes to a child started with env=None (the child then joined this job as a
+    second rank 0). drop_mpi_environment removes what the process did not start with: a
+    variable set in the C environment only (os.putenv) is dropped and reaches no child; this
+    process (tests/conftest.py) and an application process (startup) pass none of MPI's."""
+    from dolfinx_forms.common import drop_mpi_environment
+
+    started = {k for k in os.environ if k.startswith(("PMIX_", "OMPI_", "ORTE_"))}
+    os.putenv("OMPI_ILS_PROBE", "1")  # the C environment only, as MPI_Init's setenv
+    assert drop_mpi_environment() == ["OMPI_ILS_PROBE"]
+    child = subprocess.run([sys.executable, "-c", CHILD_MPI_ENV], capture_output=True, text=True)
+    assert set(json.loads(child.stdout)) <= started
+    code = (
+        "import dolfinx_forms.app, subprocess, sys; from mpi4py import MPI; "
+        f"print(subprocess.run([sys.executable, '-c', {CHILD_MPI_ENV!r}], capture_output=True,"
+        " text=True).stdout)"
+    )
+    grandchild = _python(code, OMPI_MCA_ess_singleton_isolated="0")  # a daemon, as pytest's
+    assert grandchild == ["OMPI_MCA_ess_singleton_isolated"]  # its own setting only
+
+
 def test_pkg_resources_still_works_after():
     r = _python(
         "import json, dolfinx_forms.app, pkg_resources\n"
