@@ -3,6 +3,7 @@ for and stays quiet on a sound one; a demo run outside the penalty's window repo
 metrics.json and on the console (exit 0, the answer flagged, not silently wrong)."""
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -83,8 +84,10 @@ def hertz(out, *args):
         capture_output=True,
         text=True,
         cwd=ROOT,
+        # unbuffered: what the child printed survives an exit from compiled code
+        env=dict(os.environ, PYTHONUNBUFFERED="1"),
     )
-    # everything the child said: it once exited 1 with both streams empty (long combined runs)
+    # everything the child said: twice in CI it exited 1 with both streams empty (design.md 10)
     assert r.returncode == 0, f"exit {r.returncode}\nstdout: {r.stdout[-3000:]}\nstderr: {r.stderr}"
     return json.loads((out / "metrics.json").read_text()), r
 
