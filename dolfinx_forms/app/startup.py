@@ -59,11 +59,11 @@ def isolated_session_dir(environ) -> dict:
 
     Why: every isolated singleton (no helper daemon: `start`) has the same name, job 1 of job
     family 0, so all of them share the session folder <tmp>/ompi.<host>.<uid>/jf.0/1, and each
-    removes it at MPI_Finalize when empty. Two runs at once (a parameter sweep, a test that
-    starts a demo) then race: one's MPI_Init fails with "A call to mkdir was unable to create
-    the desired directory ... jf.0/1" and exit 1 (3 of 745 runs of four concurrent Hertz
-    demos). A folder per process, which Open MPI creates and removes itself, has no one to race
-    with; a killed run leaves its empty folders behind, as Open MPI's own do."""
+    removes it at MPI_Finalize when empty. Two runs at once (a parameter sweep, `xargs -P`)
+    then race: one's MPI_Init fails with "A call to mkdir was unable to create the desired
+    directory ... jf.0/1" and exit 1 (2 of ~745 runs of four concurrent Hertz demos). A folder
+    per process, which Open MPI creates and removes itself, has no one to race with; a killed
+    run leaves its empty folders behind, as Open MPI's own do."""
     if "OMPI_MCA_orte_top_session_dir" in environ:
         return {}
     import tempfile
