@@ -257,7 +257,8 @@ class ImplicitMPM:
         # state the next step's points start from (records.transfer_friction)
         self.friction = {}
         self.step_count = 0
-        self._substep, self._made = 0, []  # the step in progress's sub-steps (`step`)
+        self._substep = 0  # the step in progress's converged sub-steps (`step`)
+        self._pending = None  # the problem of the sub-step in progress (`_band_step`)
         self.problem = None
         self.scene = None
         self._key = None  # _scene_key of self.scene
@@ -312,25 +313,19 @@ class ImplicitMPM:
         the same state with the band doubled, up to MAX_BAND_GROWTH times; the record says
         which band it used (`band`)."""
         snap = self.snapshot()
-        self._substep, self._made = 0, []  # the problems of the converged sub-steps
+        self._substep = 0
         try:
             records_ = self._advance(1.0, 0, snap)
         except Exception:
             self.restore(snap)
-            for p in self._made:
-                p.destroy()
-            self._made = []
-            # the last step's problem went when this one began (`_drop_previous`), its mesh
-            # too unless kept: the next step builds both again from the restored state
+            # each sub-step freed the problem before it (`_drop_previous`); one still here (a
+            # failure before the sub-step's own build) has nothing to fall back to it either:
+            # the next step builds problem and mesh again from the restored state
+            if self.problem is not None:
+                self.problem.destroy()
             self.problem = self.scene = self._key = None
             raise
-        split = len(self._made) > 1
-        for p in self._made[:-1]:  # petsc4py frees no PETSc object by itself
-            p.destroy()
-        p = snap = None
-        self._made = []
-        if split:  # a split step's sub-problems: collected now (`_drop_previous`)
-            gc.collect()
+        snap = None
         record = records_[-1]
         for k in _SUMMED:
             record[k] = type(record[k])(sum(r[k] for r in records_))
@@ -370,7 +365,7 @@ class ImplicitMPM:
             try:
                 record = self._step(fraction)
             except Exception:
-                if getattr(self, "_pending", None) is not None:
+                if self._pending is not None:
                     self._pending.destroy()
                     self._pending = None
                 self.restore(snap)
@@ -521,7 +516,6 @@ class ImplicitMPM:
                 b.name: self.dynamics.kinetic_energy(self.points[b.tag], self.dynamics.rho[b.tag])
                 for b in self.bodies
             }
-        self._made.append(problem)  # the step frees the problems it replaced (`step`)
         self.problem, self.scene, self._key, self._pending = problem, scene, key, None
         imap = problem.V.dofmap.index_map
         record.update(
