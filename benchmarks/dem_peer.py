@@ -6,8 +6,10 @@ steps.csv (meshes.column.COLUMNS, a row every --interval).
 
 What is compared, per seed (--seeds) and Young's modulus (--E): the stress ratio from the wall
 forces, the coordination number, the grain-grain normal forces' mean and coefficient of
-variation. summary.json: their mean and standard deviation (ddof 1) over the seeds at the end of
-compression and of shear, each LAMMPS run's wall time, the LAMMPS version; dem_peer.png: the DEM
+variation, and their mean in units of the sample's stress, force_mean_pd (meshes/column.py: the
+mean with a rigid limit). summary.json: their mean and standard deviation (ddof 1) over the seeds
+at the end of compression and of shear, each LAMMPS run's wall time, the LAMMPS version, and
+("comparison") the --mpm runs' at the same E against the DEM's band; dem_peer.png: the DEM
 mean with a +-1 std band against the shear strain (shear phase) and the time (all phases), and
 the --mpm result folders of demos/granular_column.py grouped by their --E, each group a dashed
 line with its own band over the runs.
@@ -52,7 +54,9 @@ import numpy as np
 
 from meshes import column
 
-METRICS = ("stress_ratio", "coordination", "force_mean", "force_cv")
+# force_mean_pd: the force mean in units of the sample's stress (meshes/column.py), the one
+# with a rigid limit
+METRICS = ("stress_ratio", "coordination", "force_mean", "force_cv", "force_mean_pd")
 # fmt: off
 OPTIONS = [  # option, type, accepted range, default, help
     ("--grains", int, "[2, 100000]", 100, "number of discs"),
@@ -239,12 +243,13 @@ def run_one(sample, a, E, folder):
                                a.compression, a.shear_strain)  # fmt: skip
     w = np.loadtxt(folder / "walls.txt", ndmin=2)
     steps, first = np.unique(w[:, 0].astype(int), return_index=True)  # each run's setup repeats
-    w, pairs, n = w[first], read_local(folder / "pairs.txt"), len(sample.radius)
+    w, pairs = w[first], read_local(folder / "pairs.txt")
     rows = []
     for step, (left, right, top, *f, vertical, ke) in zip(steps, w[:, 1:]):
         walls = dict(left=left, right=right, bottom=float(sample.box[0, 1]), top=top)
         t = round(step / k * a.interval, 9)
-        rows.append(column.row(protocol, t, walls, dict(zip(walls, f)), pairs.get(step, ()), n, ke))
+        rows.append(column.row(protocol, t, walls, dict(zip(walls, f)), pairs.get(step, ()), sample,
+                               ke))  # fmt: skip
         if abs(t - a.t_deposit) < 1e-6:  # the deposit: what the walls carry
             deposited = dict(rows[-1], vertical=vertical)
     weight = a.rho * a.g * np.pi * float(np.sum(sample.radius**2))
@@ -290,6 +295,76 @@ def mpm_curves(folders, dt=0.1):
         label = f"MPM E={E:g}" if E is not None else "MPM"
         curves.append((f"{label} ({len(runs)} runs)", c, std if len(runs) > 1 else None))
     return curves
+
+
+def mpm_ends(folder):
+    """(--E, {end: {metric: value}}) of a demos/granular_column.py result folder: the last
+    steps.csv row of the compression and of the whole run, as the DEM's `ends`; force_mean_pd
+    from the row's stresses and the sample's mean diameter where a run predates the column."""
+    folder = Path(folder)
+    with open(folder / "steps.csv") as f:
+        rows = list(csv.DictReader(f))
+    par = json.loads((folder / "metrics.json").read_text())["parameters"]
+    last = dict(end_of_compression=[q for q in rows if q["phase"] == "compression"][-1],
+                end_of_shear=rows[-1])  # fmt: skip
+    ends = {}
+    for name, q in last.items():
+        v = {k: float(q[k]) if q.get(k) else np.nan for k in METRICS}
+        if "force_mean_pd" not in q:
+            sample = column.random_sample(par["grains"], par["radius"], par["polydispersity"],
+                                          par["elongation"], par["roughness"], seed=par["seed"])
+            d = 2.0 * float(np.mean(sample.radius))
+            pd = column.scaled_force_mean(v["force_mean"], float(q["stress_xx"]),
+                                          float(q["stress_yy"]), d)  # fmt: skip
+            v["force_mean_pd"] = np.nan if pd is None else pd
+        ends[name] = v
+    return par.get("E"), ends
+
+
+def compare(moduli, folders):
+    """The MPM runs against the DEM at the same E: per end and metric the MPM's mean and std
+    over its runs, the DEM's, and whether the MPM's mean lies in the DEM's band (its mean +-
+    one std over the seeds)."""
+    groups = {}
+    for d in folders:
+        E, ends = mpm_ends(d)
+        groups.setdefault(f"{E:g}", []).append(ends)
+    out = {}
+    for E, runs in groups.items():
+        if E not in moduli:
+            continue
+        out[E] = {}
+        for end in ("end_of_compression", "end_of_shear"):
+            out[E][end] = {}
+            for key in METRICS:
+                vals = [r[end][key] for r in runs]
+                mean, std = spread(vals)
+                dem = moduli[E][end][key]
+                gap = abs(mean - dem["mean"])  # nan (no stress ratio yet): no verdict
+                inside = bool(gap <= dem["std"]) if np.isfinite(gap) else None
+                out[E][end][key] = dict(mpm_mean=_finite(mean), mpm_std=_finite(std),
+                                        mpm_runs=[_finite(x) for x in vals],
+                                        lammps_mean=_finite(dem["mean"]),
+                                        lammps_std=_finite(dem["std"]),
+                                        inside_lammps_band=inside)  # fmt: skip
+            verdict = {True: "inside", False: "outside", None: "n/a"}
+            print(f"E {E} {end}, MPM ({len(runs)} runs) against LAMMPS: " + ", ".join(
+                f"{k} {mean_std(v['mpm_mean'])} / {mean_std(v['lammps_mean'], v['lammps_std'])}"
+                f" ({verdict[v['inside_lammps_band']]})" for k, v in out[E][end].items()))
+    return out
+
+
+def _finite(x):
+    """x as a float, None where it is not finite (JSON has no NaN)."""
+    return float(x) if np.isfinite(x) else None
+
+
+def mean_std(mean, *std):
+    """"m" or "m +- s" for the table (None: n/a)."""
+    text = "n/a" if mean is None else f"{mean:.4g}"
+    for s in std:
+        text += " +- " + ("n/a" if s is None else f"{s:.2g}")
+    return text
 
 
 def plot(path, dem, mpm):
@@ -370,6 +445,7 @@ def main(argv=None):
         m.update(pair_coeff=f"* * {contact_model(a, E, a.mu)}", runs=records)
         summary["lammps_version"] = records[0]["version"]
         dem[E] = runs
+    summary["comparison"] = compare(summary["moduli"], a.mpm)
     (out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
     plot(out / "dem_peer.png", dem, a.mpm)
     print(f"results: {out}/summary.json, {out}/dem_peer.png, {out}/E*/seed*/steps.csv")

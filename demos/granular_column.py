@@ -130,7 +130,7 @@ def main(argv=None):
                     rec = steps.step(lambda: next(advance))
                 except StopIteration:
                     break
-                row = walls.row(rec, args.grains)
+                row = walls.row(rec, sample)
                 steps.rows.append(dict(row, **{k: rec[k] for k in COLUMNS[len(row) :]}))
                 deposited = dict(vertical=walls.vertical(rec), kinetic_energy=row["kinetic_energy"])
         steps.measure()

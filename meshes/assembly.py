@@ -191,11 +191,11 @@ class ColumnWalls:
     def vertical(self, record):
         return 0.0 - sum(record["obstacles"][p]["fy"] for p in self.NAMES.values())  # not -0.0
 
-    def row(self, record, n_grains):
+    def row(self, record, sample):
         """The meshes.column.row of an ImplicitMPM step record (grain pairs: not a plate's)."""
         from .column import row
 
         normal = [q["normal_force"] for q in record["pairs"] if q["body_j"] not in self.plates]
         energy = sum(record["kinetic_energy"].values())
         return row(self.protocol, record["time"], self.positions(), self.forces(record), normal,
-                   n_grains, energy)  # fmt: skip
+                   sample, energy)  # fmt: skip

@@ -14,7 +14,13 @@ Conventions (both codes):
   end of compression: W = W_c exp(gamma / 2), H = H_c exp(-gamma / 2), the area W H constant;
 - a contact is a grain pair pressed together (normal force > 0); the coordination number is
   2 contacts / grains (all grains, rattlers included; wall contacts are not counted); the force
-  distribution is that of the contacts' normal forces: its mean and coefficient of variation.
+  distribution is that of the contacts' normal forces: its mean and coefficient of variation;
+- the force mean in units of the sample's own stress, force_mean / (p d), p = (sigma_xx +
+  sigma_yy) / 2 and d the sample's mean diameter: a displacement-driven compression gives forces
+  that grow with the contact stiffness (LAMMPS's own force mean at the end of compression: 7, 18,
+  32 for E = 1e4, 1e5, 1e6), while f / (p d) has a rigid limit, about pi / (phi z) for packing
+  fraction phi and coordination z (p = sum over contacts of f l / (2 A), branch lengths l ~ d),
+  so it is the mean the two codes' contact laws (plane-strain continuum, 3D Hertz) can share.
 """
 
 from __future__ import annotations
@@ -153,22 +159,32 @@ def contact_statistics(normal_forces, n_grains):
                 force_cv=cv)  # fmt: skip
 
 
+def scaled_force_mean(force_mean, sxx, syy, mean_diameter):
+    """force_mean / (p d), p = (sigma_xx + sigma_yy) / 2 (module docstring); None (an empty
+    CSV cell) while the walls carry nothing."""
+    p = 0.5 * (sxx + syy)
+    return float(force_mean / (p * mean_diameter)) if p > 0 else None
+
+
 #: the columns of steps.csv of both codes (demos/granular_column.py, benchmarks/dem_peer.py)
 COLUMNS = [
     "t", "phase", "shear_strain", "left", "right", "top",
     "force_left", "force_right", "force_bottom", "force_top",
     "stress_xx", "stress_yy", "stress_ratio",
-    "contacts", "coordination", "force_mean", "force_cv", "kinetic_energy",
+    "contacts", "coordination", "force_mean", "force_cv", "kinetic_energy", "force_mean_pd",
 ]  # fmt: skip
 
 
-def row(protocol, t, walls, forces, normal_forces, n_grains, kinetic_energy):
-    """One steps.csv row (COLUMNS) from a code's state at time t."""
+def row(protocol, t, walls, forces, normal_forces, sample, kinetic_energy):
+    """One steps.csv row (COLUMNS) from a code's state at time t (`sample`: its grain count
+    and mean diameter)."""
     sxx, syy, ratio = stresses(walls, forces)
     out = dict(t=float(t), phase=protocol.phase(t), shear_strain=protocol.shear(t),
                left=walls["left"], right=walls["right"], top=walls["top"],
                stress_xx=sxx, stress_yy=syy, stress_ratio=ratio,
                kinetic_energy=float(kinetic_energy))  # fmt: skip
     out.update({f"force_{k}": float(forces[k]) for k in ("left", "right", "bottom", "top")})
-    out.update(contact_statistics(normal_forces, n_grains))
+    out.update(contact_statistics(normal_forces, len(sample.radius)))
+    d = 2.0 * float(np.mean(sample.radius))
+    out["force_mean_pd"] = scaled_force_mean(out["force_mean"], sxx, syy, d)
     return out

@@ -132,3 +132,47 @@ def test_plot_with_an_mpm_run(run, tmp_path):
     dem = {1e4: [rows_of(t) for t in tables.values()]}
     dem_peer.plot(tmp_path / "p.png", dem, [str(mpm)])
     assert (tmp_path / "p.png").stat().st_size > 0
+
+
+def test_force_mean_in_units_of_the_stress(run):
+    """force_mean_pd = force_mean / (p d): p the mean of the walls' two stresses, d the sample's
+    mean diameter; empty while no wall is loaded."""
+    out, summary, tables = run
+    for seed, table in tables.items():
+        d = 2.0 * np.mean(column.random_sample(12, 1.0, 0.2, 0, 0, 0.35, seed=seed).radius)
+        loaded = [q for q in rows_of(table) if q["stress_xx"] + q["stress_yy"] > 0]
+        assert loaded and all(q["force_mean_pd"] > 0 for q in loaded if q["contacts"] > 0)
+        for q in loaded:
+            p = 0.5 * (q["stress_xx"] + q["stress_yy"])
+            assert q["force_mean_pd"] == pytest.approx(q["force_mean"] / (p * d), rel=1e-12)
+
+
+def test_mpm_runs_compared_with_the_band(run, tmp_path):
+    """`compare`: --mpm runs at a DEM modulus against the DEM's band. The DEM's own two seeds
+    given as MPM runs have its mean (inside the band) and its per-seed values; a run without
+    the force_mean_pd column (older steps.csv) gets it from its stresses and sample."""
+    out, summary, tables = run
+    folders = []
+    for seed, table in tables.items():
+        d = tmp_path / f"seed{seed}"
+        d.mkdir()
+        header, *rows = table
+        keep = [i for i, k in enumerate(header) if k != "force_mean_pd" or seed == 1]
+        with open(d / "steps.csv", "w", newline="") as f:
+            csv.writer(f).writerows([[q[i] for i in keep] for q in table])
+        par = dict(E=1e4, grains=12, radius=1.0, polydispersity=0.2, elongation=0.0,
+                   roughness=0.0, seed=seed)  # fmt: skip
+        (d / "metrics.json").write_text(json.dumps({"parameters": par}))
+        folders.append(str(d))
+    got = dem_peer.compare(summary["moduli"], folders)["10000"]
+    for end, picked in (("end_of_compression", "compression"), ("end_of_shear", None)):
+        for key in dem_peer.METRICS:
+            c, dem = got[end][key], summary["moduli"]["10000"][end][key]
+            per_seed = [[q for q in rows_of(t) if picked in (None, q["phase"])][-1][key]
+                        for t in tables.values()]  # fmt: skip
+            if not np.isfinite(dem["mean"]):  # no stress ratio at that row: no verdict
+                assert c["inside_lammps_band"] is None
+                continue
+            assert c["mpm_runs"] == pytest.approx(per_seed, rel=1e-12)
+            assert c["mpm_mean"] == pytest.approx(dem["mean"], rel=1e-12)
+            assert c["inside_lammps_band"] is True

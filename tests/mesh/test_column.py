@@ -3,6 +3,8 @@ demos/granular_column.py and benchmarks/dem_peer.py (numpy only): the sample is 
 without contact and inside its walls; the walls follow the three phases with the area constant
 through the shear; the stresses and contact statistics of hand-made states."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -62,7 +64,11 @@ def test_stresses_and_contact_statistics():
     assert s == dict(contacts=2, coordination=1.0, force_mean=2.0, force_cv=0.5)
     assert column.contact_statistics([], 3)["force_cv"] == 0.0
     p = column.Protocol(np.array([[0.0, 0.0], [4.0, 2.0]]), 1.0, 1.0, 1.0, 0.0, 0.1)
+    sample = SimpleNamespace(radius=np.array([0.4, 0.6, 0.5, 0.5]))  # mean diameter 1
     row = column.row(p, 0.5, walls, dict(left=2.0, right=6.0, bottom=10.0, top=6.0), [1.0, 3.0],
-                     4, 0.25)  # fmt: skip
+                     sample, 0.25)  # fmt: skip
     assert set(row) == set(column.COLUMNS)  # write_table orders them
+    # force mean 2 over p d = ((2 + 2) / 2) * 1
+    assert row["force_mean_pd"] == pytest.approx(1.0, rel=1e-15)
+    assert column.scaled_force_mean(2.0, 0.0, 0.0, 1.0) is None  # no wall loaded yet
     assert row["phase"] == "deposition" and row["stress_ratio"] == 1.0 and row["contacts"] == 2
