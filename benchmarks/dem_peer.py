@@ -57,6 +57,7 @@ from meshes import column
 # force_mean_pd: the force mean in units of the sample's stress (meshes/column.py), the one
 # with a rigid limit
 METRICS = ("stress_ratio", "coordination", "force_mean", "force_cv", "force_mean_pd")
+PLOTTED = ("stress_ratio", "coordination", "force_mean_pd")  # dem_peer.png's rows
 # fmt: off
 OPTIONS = [  # option, type, accepted range, default, help
     ("--grains", int, "[2, 100000]", 100, "number of discs"),
@@ -276,13 +277,8 @@ def mpm_curves(folders, dt=0.1):
     the mean and spread over the runs (as for the DEM's seeds) of each run's rows sampled every
     `dt` (the last accepted step at or before each time: the runs' adaptive steps differ)."""
     groups = {}
-    for d in map(Path, folders):
-        with open(d / "steps.csv") as f:
-            rows = list(csv.DictReader(f))
-        s = {k: np.array([q[k] if k == "phase" else q[k] or "nan" for q in rows]) for k in rows[0]}
-        s = {k: v if k == "phase" else v.astype(float) for k, v in s.items()}  # "": no ratio
-        meta = d / "metrics.json"
-        E = json.loads(meta.read_text()).get("parameters", {}).get("E") if meta.exists() else None
+    for d in folders:
+        E, s = read_mpm(d)
         groups.setdefault(E, []).append(s)
     curves = []
     for E, runs in groups.items():
@@ -290,35 +286,43 @@ def mpm_curves(folders, dt=0.1):
         at = [np.maximum(np.searchsorted(s["t"], t + 1e-9, side="right") - 1, 0) for s in runs]
         c = {k: runs[0][k][at[0]] for k in ("phase", "shear_strain")}
         c["t"], std = t, {}
-        for key in METRICS[:2]:
+        for key in PLOTTED:
             c[key], std[key] = spread([s[key][i] for s, i in zip(runs, at)])
         label = f"MPM E={E:g}" if E is not None else "MPM"
         curves.append((f"{label} ({len(runs)} runs)", c, std if len(runs) > 1 else None))
     return curves
 
 
-def mpm_ends(folder):
-    """(--E, {end: {metric: value}}) of a demos/granular_column.py result folder: the last
-    steps.csv row of the compression and of the whole run, as the DEM's `ends`; force_mean_pd
-    from the row's stresses and the sample's mean diameter where a run predates the column."""
+def read_mpm(folder):
+    """(--E or None, steps.csv as {column: array}, phase a string and an empty cell nan) of a
+    demos/granular_column.py result folder. A run older than the force_mean_pd column gets it
+    from its stresses and its sample's mean diameter (its --grains, --radius, ..., --seed)."""
     folder = Path(folder)
     with open(folder / "steps.csv") as f:
         rows = list(csv.DictReader(f))
-    par = json.loads((folder / "metrics.json").read_text())["parameters"]
-    last = dict(end_of_compression=[q for q in rows if q["phase"] == "compression"][-1],
-                end_of_shear=rows[-1])  # fmt: skip
-    ends = {}
-    for name, q in last.items():
-        v = {k: float(q[k]) if q.get(k) else np.nan for k in METRICS}
-        if "force_mean_pd" not in q:
-            sample = column.random_sample(par["grains"], par["radius"], par["polydispersity"],
-                                          par["elongation"], par["roughness"], seed=par["seed"])
+    s = {k: np.array([q[k] if k == "phase" else q[k] or "nan" for q in rows]) for k in rows[0]}
+    s = {k: v if k == "phase" else v.astype(float) for k, v in s.items()}
+    meta = folder / "metrics.json"
+    par = json.loads(meta.read_text()).get("parameters", {}) if meta.exists() else {}
+    if "force_mean_pd" not in s:
+        names = ("grains", "radius", "polydispersity", "elongation", "roughness")
+        d = np.nan
+        if all(k in par for k in names + ("seed",)):
+            sample = column.random_sample(*(par[k] for k in names), seed=par["seed"])
             d = 2.0 * float(np.mean(sample.radius))
-            pd = column.scaled_force_mean(v["force_mean"], float(q["stress_xx"]),
-                                          float(q["stress_yy"]), d)  # fmt: skip
-            v["force_mean_pd"] = np.nan if pd is None else pd
-        ends[name] = v
-    return par.get("E"), ends
+        p = 0.5 * (s["stress_xx"] + s["stress_yy"])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s["force_mean_pd"] = np.where(p > 0, s["force_mean"] / (p * d), np.nan)
+    return par.get("E"), s
+
+
+def mpm_ends(folder):
+    """(--E, {end: {metric: value}}) of a demos/granular_column.py result folder: the last
+    steps.csv row of the compression and of the whole run, as the DEM's `ends`."""
+    E, s = read_mpm(folder)
+    last = dict(end_of_compression=np.flatnonzero(s["phase"] == "compression")[-1],
+                end_of_shear=len(s["t"]) - 1)  # fmt: skip
+    return E, {name: {k: float(s[k][i]) for k in METRICS} for name, i in last.items()}
 
 
 def compare(moduli, folders):
@@ -377,14 +381,14 @@ def plot(path, dem, mpm):
     curves = []  # (label, {column: array}, {column: std over the seeds} or None)
     for E, runs in dem.items():
         s, std = {k: np.array([q[k] for q in runs[0]]) for k in ("t", "phase", "shear_strain")}, {}
-        for key in METRICS[:2]:
+        for key in PLOTTED:
             s[key], std[key] = spread([[q[key] for q in rows] for rows in runs])
         curves.append((f"LAMMPS E={E:g} ({len(runs)} seeds)", s, std))
     curves += mpm_curves(mpm)
-    fig, ax = plt.subplots(2, 2, figsize=(11, 7))
+    fig, ax = plt.subplots(len(PLOTTED), 2, figsize=(11, 10))
     top = 0.0  # the stress ratio's axis: after deposition (it diverges in the free fall)
     for label, s, std in curves:
-        for i, key in enumerate(METRICS[:2]):
+        for i, key in enumerate(PLOTTED):
             band = std[key] if std else 0 * s[key]
             for j, (x, m) in enumerate(((s["shear_strain"], s["phase"] == "shear"), (s["t"], ...))):
                 style = "--" if label.startswith("MPM") else "-"
@@ -400,8 +404,10 @@ def plot(path, dem, mpm):
         ax[0, j].set_ylim(0, 1.3 * top if top > 0 else None)
         ax[0, j].set_ylabel("stress ratio sigma_yy / sigma_xx")
         ax[1, j].set_ylabel("coordination number")
-    ax[1, 0].set_xlabel("shear strain eps_yy - eps_xx (shear phase)")
-    ax[1, 1].set_xlabel("time (all phases)")
+        ax[2, j].set_ylabel("force mean / (p d)")
+        ax[2, j].set_yscale("log")  # the free fall's first contacts: large, before p settles
+    ax[-1, 0].set_xlabel("shear strain eps_yy - eps_xx (shear phase)")
+    ax[-1, 1].set_xlabel("time (all phases)")
     ax[0, 0].legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
