@@ -310,9 +310,9 @@ def read_mpm(folder):
         if all(k in par for k in names + ("seed",)):
             sample = column.random_sample(*(par[k] for k in names), seed=par["seed"])
             d = 2.0 * float(np.mean(sample.radius))
-        p = 0.5 * (s["stress_xx"] + s["stress_yy"])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            s["force_mean_pd"] = np.where(p > 0, s["force_mean"] / (p * d), np.nan)
+        pd = [column.scaled_force_mean(*q, d) for q in
+              zip(s["force_mean"], s["stress_xx"], s["stress_yy"])]  # fmt: skip
+        s["force_mean_pd"] = np.array([np.nan if x is None else x for x in pd])
     return par.get("E"), s
 
 
@@ -372,7 +372,8 @@ def mean_std(mean, *std):
 
 
 def plot(path, dem, mpm):
-    """dem_peer.png: stress ratio and coordination against shear strain and time."""
+    """dem_peer.png: stress ratio, coordination and force_mean_pd against shear strain and
+    time."""
     import matplotlib
 
     matplotlib.use("Agg")
