@@ -138,9 +138,14 @@ def main(argv=None):
         if run.rank0:
             evaluate(run, balance / max(total, 1e-300))
 
-        summary = ("Cantilever: first period {results[first_period]} s (Euler-Bernoulli "
-                   "{analytic[first_period]:.5g}), peak / static {results[peak_over_static]:.4f}"
-                   ", energy balance {results[energy_balance_rel_max]:.1e}")  # fmt: skip
+        # (rank 0 formats it) a run shorter than a period has none to print
+        period = "{results[first_period]:.5g} s"
+        if run.results.get("first_period") is None:
+            period = "not within t-end"
+        summary = ("Cantilever: first period " + period + " (Euler-Bernoulli "
+                   "{analytic[first_period]:.5g} s), peak / static "
+                   "{results[peak_over_static]:.4f}, energy balance "
+                   "{results[energy_balance_rel_max]:.1e}")  # fmt: skip
         files = lambda run, folder: write_table(folder / "steps.csv", COLUMNS, run.rows)  # noqa
         run.finish(summary, plot=None, files=files, solution=False, tractions=False)
     return run.status

@@ -36,6 +36,16 @@ def test_period_peak_and_energy(tmp_path):
     assert d["results"]["first_period"] > r["first_period"]
 
 
+def test_run_shorter_than_a_period_says_so(tmp_path, capsys):
+    """--t-end below one period: no period in metrics.json, a warning, and the summary line
+    says it was not reached (it printed "None" before)."""
+    m, rows = run(tmp_path / "short", "--t-end", "0.5")
+    assert len(rows) == 10 and m["results"]["first_period"] is None
+    assert "t-end holds less than one period: no period check" in m["solver"]["warnings"]
+    out = capsys.readouterr().out
+    assert "first period not within t-end (Euler-Bernoulli" in out and "None" not in out
+
+
 def tip_history(comm, steps=10):
     """The demo's problem on `comm` through the library: tip deflection per step (coarse)."""
     import ufl
