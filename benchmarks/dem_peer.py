@@ -343,13 +343,14 @@ def compare(moduli, folders):
             for key in METRICS:
                 vals = [r[end][key] for r in runs]
                 mean, std = spread(vals)
-                dem = moduli[E][end][key]
-                gap = abs(mean - dem["mean"])  # nan (no stress ratio yet): no verdict
-                inside = bool(gap <= dem["std"]) if np.isfinite(gap) else None
+                dem = moduli[E][end][key]  # None: no value (no stress ratio yet)
+                dem_mean, dem_std = (np.nan if x is None else x for x in (dem["mean"], dem["std"]))
+                gap = abs(mean - dem_mean)  # nan: no verdict
+                inside = bool(gap <= dem_std) if np.isfinite(gap) else None
                 out[E][end][key] = dict(mpm_mean=_finite(mean), mpm_std=_finite(std),
                                         mpm_runs=[_finite(x) for x in vals],
-                                        lammps_mean=_finite(dem["mean"]),
-                                        lammps_std=_finite(dem["std"]),
+                                        lammps_mean=_finite(dem_mean),
+                                        lammps_std=_finite(dem_std),
                                         inside_lammps_band=inside)  # fmt: skip
             verdict = {True: "inside", False: "outside", None: "n/a"}
             print(f"E {E} {end}, MPM ({len(runs)} runs) against LAMMPS: " + ", ".join(
@@ -446,8 +447,8 @@ def main(argv=None):
             m[name] = {}
             for key in METRICS:
                 mean, std = spread([pick(rows)[-1][key] for rows in runs])
-                m[name][key] = dict(mean=float(mean), std=float(std))
-            print(f"E {E:g} {name}: " + ", ".join(f"{key} {v['mean']:.4g} +- {v['std']:.2g}"
+                m[name][key] = dict(mean=_finite(mean), std=_finite(std))  # JSON: no NaN
+            print(f"E {E:g} {name}: " + ", ".join(f"{key} {mean_std(v['mean'], v['std'])}"
                                                   for key, v in m[name].items()))  # fmt: skip
         m.update(pair_coeff=f"* * {contact_model(a, E, a.mu)}", runs=records)
         summary["lammps_version"] = records[0]["version"]

@@ -50,8 +50,25 @@ def test_columns_are_the_shared_ones(run):
     for table in tables.values():
         assert table[0] == column.COLUMNS
         assert len(table) - 1 == round((T_DEPOSIT + T_COMPRESS + 1.0) / 0.1) + 1
-    assert json.loads((out / "summary.json").read_text()) == json.loads(json.dumps(summary))
+    text = (out / "summary.json").read_text()
+    assert json.loads(text) == json.loads(json.dumps(summary))
+    json.loads(text, parse_constant=_not_json)
     assert (out / "dem_peer.png").stat().st_size > 0
+
+
+def _not_json(name):
+    """json.loads's parse_constant: NaN and Infinity are not JSON (jq, JavaScript reject them)."""
+    raise ValueError(f"summary.json holds {name}")
+
+
+def test_summary_holds_null_where_a_value_is_missing(tmp_path):
+    """Two time units of deposition: the discs still fall, the lateral walls carry nothing at
+    the end, so there is no stress ratio there. summary.json says null (it wrote NaN)."""
+    args = ["--grains", "12", "--seeds", "1", "2", "--t-deposit", "2", "--t-compress", "1",
+            "--t-shear", "1", "--out", str(tmp_path)]  # fmt: skip
+    summary = dem_peer.main(args)
+    assert summary["moduli"]["10000"]["end_of_shear"]["stress_ratio"]["mean"] is None
+    json.loads((tmp_path / "summary.json").read_text(), parse_constant=_not_json)
 
 
 def test_deposit_rests_on_the_bottom(run):
