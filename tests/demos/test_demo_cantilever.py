@@ -43,7 +43,7 @@ def test_run_shorter_than_a_period_says_so(tmp_path, capsys):
     assert len(rows) == 10 and m["results"]["first_period"] is None
     assert "t-end holds less than one period: no period check" in m["solver"]["warnings"]
     out = capsys.readouterr().out
-    assert "first period not within t-end (Euler-Bernoulli" in out and "None" not in out
+    assert "first period within t-end none (Euler-Bernoulli" in out and "None" not in out
 
 
 def tip_history(comm, steps=10):
